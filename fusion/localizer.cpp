@@ -1,0 +1,425 @@
+#include "coloc/fusion/localizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+#include "coloc/core/error.hpp"
+#include "coloc/fusion/chi_square.hpp"
+#include "coloc/fusion/measurement_record.hpp"
+#include "coloc/fusion/state_history.hpp"
+
+namespace coloc::fusion {
+
+namespace {
+
+constexpr std::int64_t kMaxTicksPerAdvance = 10'000'000;  // ~55 h at 50 Hz: beyond that the clock jumped
+
+void requireConfig(bool ok, const char* key, const std::string& why) {
+  if (!ok) throw Error("fusion config: " + std::string(key) + " " + why);
+}
+
+void validate(const EkfConfig& c) {
+  requireConfig(std::isfinite(c.predict_frequency) && c.predict_frequency > 0.0 && c.predict_frequency <= 10000.0,
+                "predict_frequency", "must be in (0, 10000] Hz");
+  requireConfig(c.history_steps >= 0 && c.history_steps <= 100000, "history_steps", "must be in [0, 100000]");
+  requireConfig(c.pose_smoothing_steps >= 1, "pose_smoothing_steps", "must be >= 1");
+  requireConfig(c.twist_smoothing_steps >= 1, "twist_smoothing_steps", "must be >= 1");
+  requireConfig(c.max_pose_queue_size >= 1, "max_pose_queue_size", "must be >= 1");
+  requireConfig(c.max_twist_queue_size >= 1, "max_twist_queue_size", "must be >= 1");
+  requireConfig(c.pose_gate_alpha >= 0.0 && c.pose_gate_alpha < 1.0, "pose_gate_alpha", "must be in [0, 1)");
+  requireConfig(c.twist_gate_alpha >= 0.0 && c.twist_gate_alpha < 1.0, "twist_gate_alpha", "must be in [0, 1)");
+  const std::pair<const char*, double> non_negative[] = {
+      {"proc_stddev_yaw_c", c.proc_stddev_yaw_c},       {"proc_stddev_vx_c", c.proc_stddev_vx_c},
+      {"proc_stddev_wz_c", c.proc_stddev_wz_c},         {"z_filter_proc_dev", c.z_filter_proc_dev},
+      {"roll_filter_proc_dev", c.roll_filter_proc_dev}, {"pitch_filter_proc_dev", c.pitch_filter_proc_dev},
+      {"threshold_observable_velocity_mps", c.threshold_observable_velocity_mps},
+      {"future_tolerance", c.future_tolerance},         {"initial_yaw_bias_variance", c.initial_yaw_bias_variance}};
+  for (const auto& [key, value] : non_negative) requireConfig(std::isfinite(value) && value >= 0.0, key, "must be finite and >= 0");
+  requireConfig(std::isfinite(c.initial_vx_variance) && c.initial_vx_variance > 0.0, "initial_vx_variance", "must be finite and > 0");
+  requireConfig(std::isfinite(c.initial_wz_variance) && c.initial_wz_variance > 0.0, "initial_wz_variance", "must be finite and > 0");
+}
+
+HistoryOptions historyOptions(const EkfConfig& c) {
+  HistoryOptions o;
+  o.steps = c.history_steps;
+  o.step = static_cast<Duration>(std::llround(1e9 / c.predict_frequency));
+  o.noise = {c.proc_stddev_yaw_c, c.proc_stddev_vx_c, c.proc_stddev_wz_c};
+  o.aux_proc_dev = {c.z_filter_proc_dev, c.roll_filter_proc_dev, c.pitch_filter_proc_dev};
+  o.relinearize = c.relinearize_on_replay;
+  return o;
+}
+
+std::array<double, 4> gateThresholds(double alpha) {
+  std::array<double, 4> t{};
+  for (int m = 1; m <= 3; ++m) t[m] = alpha > 0.0 ? chiSquareQuantile(m, alpha) : kInfinity;
+  return t;
+}
+
+}  // namespace
+
+struct Localizer::Impl {
+  struct Source {
+    std::string name;
+    SourceKind kind;
+    SourceCounters counters;
+  };
+  // A measurement still being applied over its smoothing steps.
+  struct Active {
+    SourceId source;
+    Stamp stamp;
+    UpdateRecord record;
+    int uses_left;
+    int uses_total;
+  };
+  // A measurement whose tick the filter's clock has not reached yet.
+  struct Pending {
+    SourceId source;
+    Stamp stamp;
+    UpdateRecord record;
+  };
+
+  EkfConfig config;
+  StateHistory history;
+  std::array<double, 4> pose_gate, twist_gate;
+  bool initialized = false;
+  bool clock_set = false;
+  Stamp clock = 0;
+  Duration future_tolerance;
+  std::vector<Source> sources;
+  std::unordered_map<std::string, SourceId> by_name;
+  std::vector<Active> active;
+  std::vector<Pending> pending;
+  std::uint64_t unknown_sources = 0;
+  std::function<void(const Verdict&)> listener;
+
+  explicit Impl(const EkfConfig& c)
+      : config((validate(c), c)),
+        history(historyOptions(c)),
+        pose_gate(gateThresholds(c.pose_gate_alpha)),
+        twist_gate(gateThresholds(c.twist_gate_alpha)),
+        future_tolerance(fromSeconds(c.future_tolerance)) {}
+
+  SourceId add(const std::string& name, SourceKind kind) {
+    if (auto it = by_name.find(name); it != by_name.end()) {
+      if (sources[it->second].kind != kind)
+        throw Error("source '" + name + "' is already registered as a " +
+                    (kind == SourceKind::kPose ? "twist" : "pose") + " source");
+      return it->second;
+    }
+    sources.push_back({name, kind, {}});
+    by_name.emplace(name, static_cast<SourceId>(sources.size() - 1));
+    return static_cast<SourceId>(sources.size() - 1);
+  }
+
+  Verdict report(Verdict v) {
+    if (listener) listener(v);
+    return v;
+  }
+
+  Verdict reject(SourceId id, Stamp stamp, Reason reason, const std::string& why) {
+    Verdict v{Outcome::kRejected, reason, id >= 0 ? sources[id].name : std::string(), stamp, 0.0, {}};
+    std::ostringstream msg;
+    const char* kind = id >= 0 && sources[id].kind == SourceKind::kTwist ? "twist" : "pose";
+    msg << kind << " from '" << v.source << "' stamped " << formatSeconds(stamp) << " rejected (" << toString(reason)
+        << "): " << why;
+    v.message = msg.str();
+    if (id >= 0) {
+      SourceCounters& c = sources[id].counters;
+      switch (reason) {
+        case Reason::kNotInitialized: ++c.not_initialized; break;
+        case Reason::kInvalid: ++c.invalid; break;
+        case Reason::kTooOld: ++c.too_old; break;
+        case Reason::kFromFuture: ++c.from_future; break;
+        case Reason::kGated: ++c.gated; break;
+        case Reason::kNumerical: ++c.numerical; break;
+        default: break;
+      }
+    }
+    return report(std::move(v));
+  }
+
+  Verdict accept(SourceId id, Stamp stamp, Outcome outcome, double d2, const std::string& what) {
+    Verdict v{outcome, Reason::kNone, sources[id].name, stamp, d2, {}};
+    v.message = std::string(sources[id].kind == SourceKind::kTwist ? "twist" : "pose") + " from '" + v.source +
+                "' stamped " + formatSeconds(stamp) + " " + what;
+    return report(std::move(v));
+  }
+
+  int smoothingSteps(SourceKind kind) const {
+    return kind == SourceKind::kPose ? config.pose_smoothing_steps : config.twist_smoothing_steps;
+  }
+  int queueCapacity(SourceKind kind) const {
+    const int queue = kind == SourceKind::kPose ? config.max_pose_queue_size : config.max_twist_queue_size;
+    return std::max(queue, smoothingSteps(kind));
+  }
+
+  // Applies the remaining smoothing uses of active[i] at once (same total information) and drops it.
+  void fold(std::size_t i) {
+    Active& a = active[i];
+    if (auto back = history.ticksBack(a.stamp)) {
+      UpdateRecord r = a.record;
+      r.scale = static_cast<double>(a.uses_total) / a.uses_left;
+      history.addUpdate(*back, r);
+    }
+    ++sources[a.source].counters.smoothing_shortened;
+    active.erase(active.begin() + static_cast<std::ptrdiff_t>(i));
+  }
+
+  // First use of a measurement whose tick exists: gate it, then apply it (over its smoothing steps).
+  Verdict firstUse(SourceId id, Stamp stamp, UpdateRecord record, int back) {
+    Source& src = sources[id];
+    const double d2 = mahalanobisSquared(history.stateAt(back), record);
+    const auto& gate = src.kind == SourceKind::kPose ? pose_gate : twist_gate;
+    if (record.m > 0 && !(d2 <= gate[record.m])) {
+      std::ostringstream why;
+      why << "squared Mahalanobis distance " << d2 << " exceeds the chi-square(" << record.m << ") gate "
+          << gate[record.m];
+      Verdict v = reject(id, stamp, Reason::kGated, why.str());
+      v.mahalanobis_squared = d2;
+      return v;
+    }
+    const int steps = smoothingSteps(src.kind);
+    // The tick must stay in the history for all uses; fewer, heavier uses carry the same information.
+    const int uses = std::max(1, std::min(steps, 1 + config.history_steps - back));
+    record.scale = uses;
+    if (!history.addUpdate(back, record))
+      return reject(id, stamp, Reason::kNumerical, "innovation covariance is not positive definite");
+    ++src.counters.applied;
+    if (uses < steps) ++src.counters.smoothing_shortened;
+    if (uses > 1) {
+      int queued = 0;
+      std::size_t oldest = active.size();
+      for (std::size_t i = 0; i < active.size(); ++i)
+        if (active[i].source == id && queued++ == 0) oldest = i;
+      if (queued >= queueCapacity(src.kind)) fold(oldest);
+      active.push_back({id, stamp, record, uses - 1, uses});
+    }
+    std::ostringstream what;
+    what << "applied " << back << " ticks back (squared Mahalanobis distance " << d2 << ")";
+    return accept(id, stamp, Outcome::kApplied, d2, what.str());
+  }
+
+  FilterState initialState(const UpdateRecord& r) const {
+    FilterState s;
+    s.x.setZero();
+    s.P = Matrix6d::Zero();
+    for (int i = 0; i < r.m; ++i) {
+      s.x[r.index[i]] = r.value[i];
+      s.P(r.index[i], r.index[i]) = r.R(i, i);
+    }
+    s.x[kYaw] = wrapAngle(s.x[kYaw]);
+    s.P(kYawBias, kYawBias) = config.enable_yaw_bias_estimation ? config.initial_yaw_bias_variance : 0.0;
+    s.P(kVx, kVx) = config.initial_vx_variance;
+    s.P(kWz, kWz) = config.initial_wz_variance;
+    for (int a = 0; a < 3; ++a)
+      if (r.aux_mask & (1 << a)) s.aux[a] = {r.aux_value[a], r.aux_variance[a], true};
+    return s;
+  }
+
+  void start(Stamp stamp, const UpdateRecord& record) {
+    history.reset(stamp, initialState(record));
+    active.clear();  // their information went into the history just discarded
+    initialized = true;
+    if (!clock_set || clock < stamp) clock = stamp;
+    clock_set = true;
+    // Waiting measurements older than the new start can never find their tick.
+    std::vector<Pending> waiting;
+    waiting.swap(pending);
+    for (Pending& p : waiting) {
+      if (p.stamp < stamp - history.options().step / 2) {
+        --sources[p.source].counters.pending;
+        reject(p.source, p.stamp, Reason::kTooOld, "older than the filter's new initial pose");
+      } else {
+        pending.push_back(std::move(p));
+      }
+    }
+  }
+
+  Verdict feed(SourceId id, SourceKind kind, Stamp stamp, const RecordOrError& made) {
+    if (id < 0 || static_cast<std::size_t>(id) >= sources.size()) {
+      ++unknown_sources;
+      Verdict v{Outcome::kRejected, Reason::kUnknownSource, "#" + std::to_string(id), stamp, 0.0, {}};
+      v.message = "input from source id " + std::to_string(id) + " rejected (unknown_source): never registered";
+      return report(std::move(v));
+    }
+    Source& src = sources[id];
+    if (src.kind != kind)
+      throw Error("source '" + src.name + "' is a " + (src.kind == SourceKind::kPose ? "pose" : "twist") +
+                  " source; it cannot take a " + (kind == SourceKind::kPose ? "pose" : "twist"));
+    ++src.counters.received;
+    if (const auto* why = std::get_if<std::string>(&made)) return reject(id, stamp, Reason::kInvalid, *why);
+    const UpdateRecord& record = std::get<UpdateRecord>(made);
+    if (!initialized) {
+      if (kind == SourceKind::kPose && config.auto_initialize && measuresPlanarPose(record)) {
+        start(stamp, record);
+        ++src.counters.applied;
+        return accept(id, stamp, Outcome::kApplied, 0.0, "initialised the filter");
+      }
+      return reject(id, stamp, Reason::kNotInitialized, "no initial pose yet");
+    }
+    if (stamp > clock + future_tolerance)
+      return reject(id, stamp, Reason::kFromFuture,
+                    "stamp is " + formatSeconds(stamp - clock) + " s ahead of the clock (tolerance " +
+                        formatSeconds(future_tolerance) + " s)");
+    if (auto back = history.ticksBack(stamp)) return firstUse(id, stamp, record, *back);
+    if (stamp < history.latestStamp()) {
+      return reject(id, stamp, Reason::kTooOld,
+                    "stamp is " + formatSeconds(history.latestStamp() - stamp) + " s behind the newest tick; the history reaches back " +
+                        formatSeconds(history.latestStamp() - history.oldestStamp()) + " s");
+    }
+    pending.push_back({id, stamp, record});
+    ++src.counters.pending;
+    return accept(id, stamp, Outcome::kPending, 0.0, "waits for the filter's clock to reach its stamp");
+  }
+
+  void tick() {
+    history.advance();
+    // Continuing smoothing uses first: they were accepted before anything that resolves now.
+    for (std::size_t i = 0; i < active.size();) {
+      Active& a = active[i];
+      const auto back = history.ticksBack(a.stamp);
+      UpdateRecord r = a.record;
+      r.scale = a.uses_total;
+      if (back) history.addUpdate(*back, r);
+      if (--a.uses_left == 0 || !back) {
+        active.erase(active.begin() + static_cast<std::ptrdiff_t>(i));
+      } else {
+        ++i;
+      }
+    }
+    // Measurements that waited for this tick, in stamp order (stable for equal stamps).
+    std::stable_sort(pending.begin(), pending.end(), [](const Pending& a, const Pending& b) { return a.stamp < b.stamp; });
+    std::size_t resolved = 0;
+    while (resolved < pending.size()) {
+      const auto back = history.ticksBack(pending[resolved].stamp);
+      if (!back) break;
+      ++resolved;
+    }
+    std::vector<Pending> ready(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(resolved));
+    pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(resolved));
+    for (Pending& p : ready) {
+      --sources[p.source].counters.pending;
+      firstUse(p.source, p.stamp, p.record, *history.ticksBack(p.stamp));
+    }
+  }
+
+  Verdict advanceTo(Stamp now) {
+    if (clock_set && now < clock) {
+      Verdict v{Outcome::kRejected, Reason::kClockBackwards, "", now, 0.0, {}};
+      v.message = "clock rejected (clock_backwards): " + formatSeconds(now) + " is before the previous " + formatSeconds(clock);
+      return report(std::move(v));
+    }
+    if (initialized) {
+      const Duration step = history.options().step;
+      const std::int64_t ticks = (now - history.latestStamp()) / step;
+      if (ticks > kMaxTicksPerAdvance) {
+        Verdict v{Outcome::kRejected, Reason::kClockBackwards, "", now, 0.0, {}};
+        v.message = "clock rejected: a jump of " + formatSeconds(now - history.latestStamp()) +
+                    " s would need more than 10 million prediction ticks; initialise the filter again";
+        return report(std::move(v));
+      }
+    }
+    clock = now;
+    clock_set = true;
+    if (initialized)
+      while (history.latestStamp() + history.options().step <= now) tick();
+    return Verdict{Outcome::kApplied, Reason::kNone, "", now, 0.0, "clock advanced"};
+  }
+
+  Estimate estimate() {
+    const FilterState& s = history.latest();
+    Estimate e;
+    e.stamp = history.latestStamp();
+    e.state = s.x;
+    e.state_covariance = s.P;
+    e.yaw_bias = s.x[kYawBias];
+    const double z = s.aux[kAuxZ].initialized ? s.aux[kAuxZ].value : 0.0;
+    const double roll = s.aux[kAuxRoll].initialized ? s.aux[kAuxRoll].value : 0.0;
+    const double pitch = s.aux[kAuxPitch].initialized ? s.aux[kAuxPitch].value : 0.0;
+    e.pose.position = {s.x[kX], s.x[kY], z};
+    e.pose.orientation = quaternionFromRollPitchYaw(roll, pitch, wrapAngle(s.x[kYaw] + s.x[kYawBias]));
+    const int rows[3] = {0, 1, 5};
+    const int states[3] = {kX, kY, kYaw};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) e.pose_covariance(rows[i], rows[j]) = s.P(states[i], states[j]);
+    for (int a = 0; a < 3; ++a) e.pose_covariance(2 + a, 2 + a) = s.aux[a].variance;  // +inf until measured
+    e.linear_velocity = {s.x[kVx], 0.0, 0.0};
+    e.angular_velocity = {0.0, 0.0, s.x[kWz]};
+    for (int i = 1; i < 5; ++i) e.twist_covariance(i, i) = kInfinity;  // vy, vz, wx, wy are not estimated
+    e.twist_covariance(0, 0) = s.P(kVx, kVx);
+    e.twist_covariance(0, 5) = e.twist_covariance(5, 0) = s.P(kVx, kWz);
+    e.twist_covariance(5, 5) = s.P(kWz, kWz);
+    return e;
+  }
+};
+
+Localizer::Localizer(const EkfConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+Localizer::~Localizer() = default;
+Localizer::Localizer(Localizer&&) noexcept = default;
+Localizer& Localizer::operator=(Localizer&&) noexcept = default;
+
+SourceId Localizer::addPoseSource(const std::string& name) { return impl_->add(name, SourceKind::kPose); }
+SourceId Localizer::addTwistSource(const std::string& name) { return impl_->add(name, SourceKind::kTwist); }
+
+std::optional<SourceId> Localizer::findSource(std::string_view name) const {
+  auto it = impl_->by_name.find(std::string(name));
+  if (it == impl_->by_name.end()) return std::nullopt;
+  return it->second;
+}
+
+Verdict Localizer::initialize(const PoseMeasurement& pose) {
+  const RecordOrError made = makePoseRecord(pose);
+  Verdict v{Outcome::kRejected, Reason::kInvalid, "initial pose", pose.stamp, 0.0, {}};
+  if (const auto* why = std::get_if<std::string>(&made)) {
+    v.message = "initial pose rejected (invalid): " + *why;
+  } else if (!measuresPlanarPose(std::get<UpdateRecord>(made))) {
+    v.message = "initial pose rejected (invalid): x, y and yaw must all have finite variance";
+  } else {
+    impl_->start(pose.stamp, std::get<UpdateRecord>(made));
+    v = {Outcome::kApplied, Reason::kNone, "initial pose", pose.stamp, 0.0,
+         "filter initialised at " + formatSeconds(pose.stamp)};
+  }
+  return impl_->report(std::move(v));
+}
+
+bool Localizer::initialized() const { return impl_->initialized; }
+
+Verdict Localizer::feedPose(SourceId source, const PoseMeasurement& m) {
+  return impl_->feed(source, SourceKind::kPose, m.stamp, makePoseRecord(m));
+}
+
+Verdict Localizer::feedTwist(SourceId source, const TwistMeasurement& m) {
+  return impl_->feed(source, SourceKind::kTwist, m.stamp,
+                     makeTwistRecord(m, impl_->config.threshold_observable_velocity_mps));
+}
+
+Verdict Localizer::feedPose(std::string_view source, const PoseMeasurement& m) {
+  return feedPose(findSource(source).value_or(-1), m);
+}
+
+Verdict Localizer::feedTwist(std::string_view source, const TwistMeasurement& m) {
+  return feedTwist(findSource(source).value_or(-1), m);
+}
+
+Verdict Localizer::advanceTo(Stamp now) { return impl_->advanceTo(now); }
+
+std::optional<Estimate> Localizer::estimate() {
+  if (!impl_->initialized) return std::nullopt;
+  return impl_->estimate();
+}
+
+void Localizer::setVerdictListener(std::function<void(const Verdict&)> listener) { impl_->listener = std::move(listener); }
+
+std::vector<SourceReport> Localizer::sources() const {
+  std::vector<SourceReport> out;
+  for (const auto& s : impl_->sources) out.push_back({s.name, s.kind, s.counters});
+  return out;
+}
+
+const SourceCounters& Localizer::counters(SourceId source) const { return impl_->sources.at(source).counters; }
+const EkfConfig& Localizer::config() const { return impl_->config; }
+std::uint64_t Localizer::unknownSourceCount() const { return impl_->unknown_sources; }
+
+}  // namespace coloc::fusion

@@ -1,0 +1,102 @@
+#include "coloc/fusion/measurement_update.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "coloc/fusion/motion_model.hpp"
+
+namespace coloc::fusion {
+
+namespace {
+
+bool isAngle(int state_index) { return state_index == kYaw; }
+
+// Solves S X = B for the top-left m x m block of S, via Cholesky; false if S is not positive definite.
+template <int Cols>
+bool solveSpd(const Eigen::Matrix3d& S, int m, const Eigen::Matrix<double, 3, Cols>& B,
+              Eigen::Matrix<double, 3, Cols>& X) {
+  switch (m) {
+    case 1:
+      if (!(S(0, 0) > 0.0)) return false;
+      X.template topRows<1>() = B.template topRows<1>() / S(0, 0);
+      return true;
+    case 2: {
+      Eigen::LLT<Eigen::Matrix2d> llt(S.topLeftCorner<2, 2>());
+      if (llt.info() != Eigen::Success) return false;
+      X.template topRows<2>() = llt.solve(B.template topRows<2>());
+      return true;
+    }
+    case 3: {
+      Eigen::LLT<Eigen::Matrix3d> llt(S);
+      if (llt.info() != Eigen::Success) return false;
+      X = llt.solve(B);
+      return true;
+    }
+    default:
+      return false;
+  }
+}
+
+void updateAux(ScalarFilter& filter, double value, double variance, bool angle) {
+  if (!filter.initialized) {
+    filter = {value, variance, true};
+    return;
+  }
+  const double residual = angle ? wrapAngle(value - filter.value) : value - filter.value;
+  const double gain = filter.variance / (filter.variance + variance);
+  filter.value += gain * residual;
+  if (angle) filter.value = wrapAngle(filter.value);
+  filter.variance *= 1.0 - gain;
+}
+
+}  // namespace
+
+Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale) {
+  Innovation out;
+  out.m = record.m;
+  for (int i = 0; i < record.m; ++i) {
+    const int si = record.index[i];
+    const double residual = record.value[i] - state.x[si];
+    out.e[i] = isAngle(si) ? wrapAngle(residual) : residual;
+    for (int j = 0; j < record.m; ++j) out.S(i, j) = state.P(si, record.index[j]) + scale * record.R(i, j);
+  }
+  return out;
+}
+
+double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) {
+  if (record.m == 0) return 0.0;
+  const Innovation in = innovation(state, record, 1.0);
+  Eigen::Matrix<double, 3, 1> solved = Eigen::Matrix<double, 3, 1>::Zero();
+  if (!solveSpd<1>(in.S, in.m, in.e, solved)) return kInfinity;
+  return in.e.head(in.m).dot(solved.head(in.m));
+}
+
+bool applyUpdate(FilterState& state, const UpdateRecord& record) {
+  if (record.m > 0) {
+    const Innovation in = innovation(state, record, record.scale);
+    // PHt = P H^T: the columns of P selected by the measured components.
+    Eigen::Matrix<double, 6, 3> PHt = Eigen::Matrix<double, 6, 3>::Zero();
+    for (int i = 0; i < record.m; ++i) PHt.col(i) = state.P.col(record.index[i]);
+    // K = PHt S^-1, computed as (S^-1 PHt^T)^T since S is symmetric.
+    Eigen::Matrix<double, 3, 6> KT = Eigen::Matrix<double, 3, 6>::Zero();
+    if (!solveSpd<6>(in.S, in.m, PHt.transpose(), KT)) return false;
+    const Eigen::Matrix<double, 6, 3> K = KT.transpose();
+    state.x += K * in.e;
+    state.x[kYaw] = wrapAngle(state.x[kYaw]);
+    state.P -= K * PHt.transpose();
+    state.P = 0.5 * (state.P + state.P.transpose());
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (record.aux_mask & (1 << a))
+      updateAux(state.aux[a], record.aux_value[a], record.aux_variance[a] * record.scale, a != kAuxZ);
+  }
+  return true;
+}
+
+void predictAux(FilterState& state, const std::array<double, 3>& proc_dev, double dt) {
+  for (int a = 0; a < 3; ++a) {
+    if (state.aux[a].initialized) state.aux[a].variance += (proc_dev[a] * dt) * (proc_dev[a] * dt);
+  }
+}
+
+}  // namespace coloc::fusion

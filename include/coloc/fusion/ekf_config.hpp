@@ -1,0 +1,55 @@
+#pragma once
+// Every tunable of the filter, with its default, in one place. The defaults are Autoware
+// ekf_localizer's (ekf_localizer.param.yaml) except where a comment says why coloc differs.
+// Units are SI; durations are seconds here because this is the human-facing edge.
+namespace coloc::fusion {
+
+struct EkfConfig {
+  double predict_frequency = 50.0;  ///< Hz; the fixed prediction rate on the caller's clock
+  int history_steps = 50;           ///< ticks of state history kept for delayed measurements (1 s)
+  bool enable_yaw_bias_estimation = true;
+  /// Re-evaluate the motion model and its Jacobian when a delayed measurement is replayed through the
+  /// history. On: a late measurement gives exactly the estimate an on-time one would. Off: the
+  /// linearisation of each step is frozen at prediction time, which reproduces Autoware's
+  /// extended-state filter to rounding error.
+  bool relinearize_on_replay = true;
+
+  double proc_stddev_yaw_c = 0.005;  ///< rad/s; yaw process noise, Q = (c * dt)^2
+  double proc_stddev_vx_c = 10.0;    ///< m/s^2; speed process noise
+  double proc_stddev_wz_c = 5.0;     ///< rad/s^2; yaw-rate process noise
+
+  int pose_smoothing_steps = 5;   ///< ticks over which one pose is applied, each with covariance x steps
+  int max_pose_queue_size = 5;    ///< poses of one source being smoothed at once
+  int twist_smoothing_steps = 2;
+  int max_twist_queue_size = 2;
+
+  /// Probability that a correct measurement is rejected by the Mahalanobis gate; the gate compares the
+  /// squared distance with the chi-square quantile of 1 - alpha for the measurement's dimension.
+  /// 1e-10 gives Autoware's 49.5 (3 dof) and 46.1 (2 dof), now applied to the squared distance. 0 = off.
+  double pose_gate_alpha = 1e-10;
+  double twist_gate_alpha = 1e-10;
+
+  double z_filter_proc_dev = 5.0;      ///< m/s; random walk of the separate z filter
+  double roll_filter_proc_dev = 0.1;   ///< rad/s
+  double pitch_filter_proc_dev = 0.1;  ///< rad/s
+
+  /// Below this |vx| a twist's speed variance is raised to 10000 (Autoware's dead band). 0 = off.
+  double threshold_observable_velocity_mps = 0.0;
+
+  /// A measurement stamped later than the caller's clock by more than this is rejected as from the
+  /// future; within it, it waits until the filter's clock reaches its stamp.
+  double future_tolerance = 0.05;  ///< s
+
+  // Initial uncertainty of the states an initial pose does not give. Autoware uses 0.01 for vx and wz,
+  // which assumes a standing start: with a correct gate, a filter started on a moving vehicle would
+  // then refuse its odometry for most of a second. A pose says nothing about speed, so coloc starts
+  // with sigma 10 m/s and 1 rad/s and lets the first twist set them.
+  double initial_yaw_bias_variance = 1e-4;  ///< rad^2
+  double initial_vx_variance = 100.0;       ///< (m/s)^2
+  double initial_wz_variance = 1.0;         ///< (rad/s)^2
+
+  /// A pose measurement that measures x, y and yaw initialises the filter when none has been given.
+  bool auto_initialize = true;
+};
+
+}  // namespace coloc::fusion

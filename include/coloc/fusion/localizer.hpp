@@ -1,0 +1,87 @@
+#pragma once
+// The Localizer: the one object a vehicle stack or a log replayer talks to. Feed it poses from any
+// number of named sources and twists, advance its clock, read the estimate. It owns the EKF, its
+// state history (delay compensation), the smoothing queues, the gates and the counters.
+//
+// Threading: not thread-safe; call it from one thread (or guard it), as a ROS node's single executor does.
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "coloc/core/types.hpp"
+#include "coloc/fusion/ekf_config.hpp"
+#include "coloc/fusion/verdict.hpp"
+
+namespace coloc::fusion {
+
+enum class SourceKind : std::uint8_t { kPose, kTwist };
+
+using SourceId = int;
+
+/// The fused estimate at the filter's newest tick.
+struct Estimate {
+  Stamp stamp = 0;
+  Pose pose;  ///< yaw is the heading of motion: measured yaw + estimated yaw bias
+  Matrix6d pose_covariance = Matrix6d::Zero();  ///< (x, y, z, roll, pitch, yaw); +inf where never measured
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   ///< (vx, 0, 0), body frame
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< (0, 0, wz)
+  Matrix6d twist_covariance = Matrix6d::Zero();  ///< (vx .. wz); only vx and wz entries are estimated
+  double yaw_bias = 0.0;
+  Vector6d state = Vector6d::Zero();  ///< raw EKF state [x, y, yaw, yaw_bias, vx, wz]
+  Matrix6d state_covariance = Matrix6d::Zero();
+};
+
+struct SourceReport {
+  std::string name;
+  SourceKind kind;
+  SourceCounters counters;
+};
+
+class Localizer {
+ public:
+  /// Throws coloc::Error naming the key if the config is out of range.
+  explicit Localizer(const EkfConfig& config = {});
+  ~Localizer();
+  Localizer(Localizer&&) noexcept;
+  Localizer& operator=(Localizer&&) noexcept;
+
+  /// Registers a named input. Names are unique across kinds; registering a name twice returns its id.
+  SourceId addPoseSource(const std::string& name);
+  SourceId addTwistSource(const std::string& name);
+  std::optional<SourceId> findSource(std::string_view name) const;
+
+  /// Starts (or restarts) the filter at a pose; x, y and yaw must be measured.
+  Verdict initialize(const PoseMeasurement& pose);
+  bool initialized() const;
+
+  Verdict feedPose(SourceId source, const PoseMeasurement& measurement);
+  Verdict feedPose(std::string_view source, const PoseMeasurement& measurement);
+  Verdict feedTwist(SourceId source, const TwistMeasurement& measurement);
+  Verdict feedTwist(std::string_view source, const TwistMeasurement& measurement);
+
+  /// Runs the fixed-rate prediction up to `now` on the caller's clock (live or log time). Measurements
+  /// waiting for their tick and the remaining smoothing steps are applied as ticks pass.
+  Verdict advanceTo(Stamp now);
+
+  /// The estimate at the newest tick; nullopt before initialisation.
+  std::optional<Estimate> estimate();
+
+  /// Verdicts decided later than the call that fed them (pending measurements) reach this listener;
+  /// every verdict returned from a call also does.
+  void setVerdictListener(std::function<void(const Verdict&)> listener);
+
+  std::vector<SourceReport> sources() const;
+  const SourceCounters& counters(SourceId source) const;
+  const EkfConfig& config() const;
+  /// Inputs naming a source that was never registered.
+  std::uint64_t unknownSourceCount() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace coloc::fusion

@@ -1,0 +1,41 @@
+#pragma once
+// One Kalman update of a FilterState by the measured components of a pose or twist. Components whose
+// variance is +infinity are simply absent from the record, so the update runs on the others exactly.
+#include <array>
+#include <cstdint>
+
+#include "coloc/fusion/filter_state.hpp"
+
+namespace coloc::fusion {
+
+struct UpdateRecord {
+  int m = 0;                              ///< number of EKF components measured (0..3)
+  std::array<int, 3> index{};             ///< state index of each component
+  std::array<double, 3> value{};          ///< measured value (angles unwrapped at use time)
+  Eigen::Matrix3d R = Eigen::Matrix3d::Zero();  ///< covariance of the measured components (top-left m x m)
+  int aux_mask = 0;                       ///< bit i set: aux filter i (z, roll, pitch) measured
+  std::array<double, 3> aux_value{};
+  std::array<double, 3> aux_variance{};
+  /// Multiplies every covariance when applied: smoothing applies a measurement n times at n R.
+  double scale = 1.0;
+};
+
+/// Innovation e = y - H x (angles wrapped) and its covariance S = H P H^T + R (R unscaled).
+struct Innovation {
+  int m = 0;
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+};
+Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale);
+
+/// e^T S^-1 e with the measurement's own covariance; +inf if S is not positive definite.
+double mahalanobisSquared(const FilterState& state, const UpdateRecord& record);
+
+/// Applies the record with covariance x record.scale. Returns false (state untouched) only if the
+/// innovation covariance is not positive definite, which validated input cannot produce.
+bool applyUpdate(FilterState& state, const UpdateRecord& record);
+
+/// Grows the aux filters' variances over one tick: var += (q dt)^2.
+void predictAux(FilterState& state, const std::array<double, 3>& proc_dev, double dt);
+
+}  // namespace coloc::fusion

@@ -1,0 +1,30 @@
+#pragma once
+// The constant-velocity, constant-yaw-rate model of Autoware's ekf_localizer on the state
+// [x, y, yaw, yaw_bias, vx, wz]. The vehicle moves along yaw + yaw_bias; yaw is the heading the pose
+// sources measure.
+#include "coloc/core/types.hpp"
+
+namespace coloc::fusion {
+
+enum StateIndex : int { kX = 0, kY = 1, kYaw = 2, kYawBias = 3, kVx = 4, kWz = 5 };
+constexpr int kStateSize = 6;
+
+struct ProcessNoise {
+  double yaw_c = 0.005;
+  double vx_c = 10.0;
+  double wz_c = 5.0;
+};
+
+/// x + f(x) dt; yaw wrapped to (-pi, pi].
+Vector6d predictState(const Vector6d& x, double dt);
+
+/// d predictState / dx, evaluated at x.
+Matrix6d motionJacobian(const Vector6d& x, double dt);
+
+/// diag(0, 0, (yaw_c dt)^2, 0, (vx_c dt)^2, (wz_c dt)^2), Autoware's discrete process noise.
+Matrix6d processNoise(const ProcessNoise& noise, double dt);
+
+/// P' = A P A^T + Q, exploiting that A is the identity plus a few entries.
+Matrix6d propagateCovariance(const Matrix6d& A, const Matrix6d& P, const Matrix6d& Q);
+
+}  // namespace coloc::fusion

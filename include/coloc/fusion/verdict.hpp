@@ -1,0 +1,55 @@
+#pragma once
+// What became of one input: applied, waiting for the filter's clock, or rejected for a named reason.
+#include <cstdint>
+#include <string>
+
+#include "coloc/core/time.hpp"
+
+namespace coloc::fusion {
+
+enum class Outcome : std::uint8_t { kApplied, kPending, kRejected };
+
+enum class Reason : std::uint8_t {
+  kNone,
+  kNotInitialized,   ///< no initial pose yet
+  kUnknownSource,    ///< source name or id never registered
+  kInvalid,          ///< non-finite value, bad covariance, nothing measured
+  kTooOld,           ///< stamp older than the state history
+  kFromFuture,       ///< stamp ahead of the caller's clock beyond the tolerance
+  kGated,            ///< Mahalanobis gate refused it
+  kClockBackwards,   ///< advanceTo with an earlier time than before
+  kNumerical,        ///< innovation covariance not positive definite
+};
+
+const char* toString(Outcome outcome);
+const char* toString(Reason reason);
+
+struct Verdict {
+  Outcome outcome = Outcome::kApplied;
+  Reason reason = Reason::kNone;
+  std::string source;   ///< the source's name ("" for clock calls)
+  Stamp stamp = 0;      ///< the input's stamp
+  double mahalanobis_squared = 0.0;  ///< of the first use, when gated or applied
+  std::string message;  ///< human-readable: names the input and the reason
+
+  bool applied() const { return outcome == Outcome::kApplied; }
+  bool rejected() const { return outcome == Outcome::kRejected; }
+};
+
+/// Per-source tallies; every input lands in exactly one of the final counters or in `pending`.
+struct SourceCounters {
+  std::uint64_t received = 0;
+  std::uint64_t applied = 0;
+  std::uint64_t pending = 0;          ///< waiting for the filter's clock (not final)
+  std::uint64_t gated = 0;
+  std::uint64_t too_old = 0;
+  std::uint64_t from_future = 0;
+  std::uint64_t invalid = 0;
+  std::uint64_t not_initialized = 0;
+  std::uint64_t numerical = 0;
+  /// Applied, but with fewer smoothing steps than configured because the history or the queue ran
+  /// out; the measurement's full information still went in.
+  std::uint64_t smoothing_shortened = 0;
+};
+
+}  // namespace coloc::fusion

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Sets up a fresh Debian bookworm machine for coloc, builds it, and runs the main job on built-in
+# defaults. Re-running it is cheap: packages already present are skipped, the build is incremental.
+set -euo pipefail
+cd "$(dirname "$0")"
+
+packages=(
+  build-essential cmake pkg-config ccache
+  libeigen3-dev
+  libfastcdr-dev libfastrtps-dev fastddsgen
+  libsqlite3-dev libzstd-dev liblz4-dev libyaml-cpp-dev
+  libcli11-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+missing=()
+for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+if ((${#missing[@]})); then
+  sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "coloc setup: installing ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j2
+
+if [ -x build/tools/coloc ]; then
+  build/tools/coloc fuse ../shared/data/real/rosbag2/nav2_turtlebot.mcap --out results/nav2_turtlebot
+fi
