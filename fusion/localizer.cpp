@@ -118,13 +118,13 @@ struct Localizer::Impl {
     return v;
   }
 
-  Verdict reject(SourceId id, Stamp stamp, Reason reason, const std::string& why) {
-    Verdict v{Outcome::kRejected, reason, id >= 0 ? sources[id].name : std::string(), stamp, 0.0, {}};
-    std::ostringstream msg;
-    const char* kind = id >= 0 && sources[id].kind == SourceKind::kTwist ? "twist" : "pose";
-    msg << kind << " from '" << v.source << "' stamped " << formatSeconds(stamp) << " rejected (" << toString(reason)
-        << "): " << why;
-    v.message = msg.str();
+  InputKind inputKind(SourceId id) const {
+    return id >= 0 && sources[id].kind == SourceKind::kTwist ? InputKind::kTwist : InputKind::kPose;
+  }
+
+  Verdict reject(SourceId id, Stamp stamp, Reason reason, std::string why) {
+    Verdict v{Outcome::kRejected, reason, inputKind(id), id >= 0 ? sources[id].name : std::string(), stamp, -1, 0.0,
+              std::move(why)};
     if (id >= 0) {
       SourceCounters& c = sources[id].counters;
       switch (reason) {
@@ -140,11 +140,8 @@ struct Localizer::Impl {
     return report(std::move(v));
   }
 
-  Verdict accept(SourceId id, Stamp stamp, Outcome outcome, double d2, const std::string& what) {
-    Verdict v{outcome, Reason::kNone, sources[id].name, stamp, d2, {}};
-    v.message = std::string(sources[id].kind == SourceKind::kTwist ? "twist" : "pose") + " from '" + v.source +
-                "' stamped " + formatSeconds(stamp) + " " + what;
-    return report(std::move(v));
+  Verdict accept(SourceId id, Stamp stamp, Outcome outcome, int ticks_back, double d2, std::string note = {}) {
+    return report(Verdict{outcome, Reason::kNone, inputKind(id), sources[id].name, stamp, ticks_back, d2, std::move(note)});
   }
 
   int smoothingSteps(SourceKind kind) const {
@@ -176,9 +173,9 @@ struct Localizer::Impl {
       std::ostringstream why;
       why << "squared Mahalanobis distance " << d2 << " exceeds the chi-square(" << record.m << ") gate "
           << gate[record.m];
-      Verdict v = reject(id, stamp, Reason::kGated, why.str());
-      v.mahalanobis_squared = d2;
-      return v;
+      Verdict v{Outcome::kRejected, Reason::kGated, inputKind(id), src.name, stamp, back, d2, why.str()};
+      ++src.counters.gated;
+      return report(std::move(v));
     }
     const int steps = smoothingSteps(src.kind);
     // The tick must stay in the history for all uses; fewer, heavier uses carry the same information.
@@ -196,9 +193,7 @@ struct Localizer::Impl {
       if (queued >= queueCapacity(src.kind)) fold(oldest);
       active.push_back({id, stamp, record, uses - 1, uses});
     }
-    std::ostringstream what;
-    what << "applied " << back << " ticks back (squared Mahalanobis distance " << d2 << ")";
-    return accept(id, stamp, Outcome::kApplied, d2, what.str());
+    return accept(id, stamp, Outcome::kApplied, back, d2);
   }
 
   FilterState initialState(const UpdateRecord& r) const {
@@ -240,9 +235,9 @@ struct Localizer::Impl {
   Verdict feed(SourceId id, SourceKind kind, Stamp stamp, const RecordOrError& made) {
     if (id < 0 || static_cast<std::size_t>(id) >= sources.size()) {
       ++unknown_sources;
-      Verdict v{Outcome::kRejected, Reason::kUnknownSource, "#" + std::to_string(id), stamp, 0.0, {}};
-      v.message = "input from source id " + std::to_string(id) + " rejected (unknown_source): never registered";
-      return report(std::move(v));
+      return report(Verdict{Outcome::kRejected, Reason::kUnknownSource,
+                            kind == SourceKind::kTwist ? InputKind::kTwist : InputKind::kPose, "#" + std::to_string(id),
+                            stamp, -1, 0.0, "no source with this id or name was registered"});
     }
     Source& src = sources[id];
     if (src.kind != kind)
@@ -255,7 +250,7 @@ struct Localizer::Impl {
       if (kind == SourceKind::kPose && config.auto_initialize && measuresPlanarPose(record)) {
         start(stamp, record);
         ++src.counters.applied;
-        return accept(id, stamp, Outcome::kApplied, 0.0, "initialised the filter");
+        return accept(id, stamp, Outcome::kApplied, 0, 0.0, "initialised the filter");
       }
       return reject(id, stamp, Reason::kNotInitialized, "no initial pose yet");
     }
@@ -271,7 +266,7 @@ struct Localizer::Impl {
     }
     pending.push_back({id, stamp, record});
     ++src.counters.pending;
-    return accept(id, stamp, Outcome::kPending, 0.0, "waits for the filter's clock to reach its stamp");
+    return accept(id, stamp, Outcome::kPending, -1, 0.0, "waits for the filter's clock to reach its stamp");
   }
 
   void tick() {
@@ -306,26 +301,21 @@ struct Localizer::Impl {
   }
 
   Verdict advanceTo(Stamp now) {
-    if (clock_set && now < clock) {
-      Verdict v{Outcome::kRejected, Reason::kClockBackwards, "", now, 0.0, {}};
-      v.message = "clock rejected (clock_backwards): " + formatSeconds(now) + " is before the previous " + formatSeconds(clock);
-      return report(std::move(v));
-    }
+    if (clock_set && now < clock)
+      return report(Verdict{Outcome::kRejected, Reason::kClockBackwards, InputKind::kClock, "", now, -1, 0.0,
+                            "before the previous time " + formatSeconds(clock)});
     if (initialized) {
-      const Duration step = history.options().step;
-      const std::int64_t ticks = (now - history.latestStamp()) / step;
-      if (ticks > kMaxTicksPerAdvance) {
-        Verdict v{Outcome::kRejected, Reason::kClockBackwards, "", now, 0.0, {}};
-        v.message = "clock rejected: a jump of " + formatSeconds(now - history.latestStamp()) +
-                    " s would need more than 10 million prediction ticks; initialise the filter again";
-        return report(std::move(v));
-      }
+      const std::int64_t ticks = (now - history.latestStamp()) / history.options().step;
+      if (ticks > kMaxTicksPerAdvance)
+        return report(Verdict{Outcome::kRejected, Reason::kClockBackwards, InputKind::kClock, "", now, -1, 0.0,
+                              "a jump of " + formatSeconds(now - history.latestStamp()) +
+                                  " s would need more than 10 million prediction ticks; initialise the filter again"});
     }
     clock = now;
     clock_set = true;
     if (initialized)
       while (history.latestStamp() + history.options().step <= now) tick();
-    return Verdict{Outcome::kApplied, Reason::kNone, "", now, 0.0, "clock advanced"};
+    return Verdict{Outcome::kApplied, Reason::kNone, InputKind::kClock, "", now, -1, 0.0, {}};
   }
 
   Estimate estimate() {
@@ -371,15 +361,14 @@ std::optional<SourceId> Localizer::findSource(std::string_view name) const {
 
 Verdict Localizer::initialize(const PoseMeasurement& pose) {
   const RecordOrError made = makePoseRecord(pose);
-  Verdict v{Outcome::kRejected, Reason::kInvalid, "initial pose", pose.stamp, 0.0, {}};
+  Verdict v{Outcome::kRejected, Reason::kInvalid, InputKind::kInitialPose, "", pose.stamp, -1, 0.0, {}};
   if (const auto* why = std::get_if<std::string>(&made)) {
-    v.message = "initial pose rejected (invalid): " + *why;
+    v.detail = *why;
   } else if (!measuresPlanarPose(std::get<UpdateRecord>(made))) {
-    v.message = "initial pose rejected (invalid): x, y and yaw must all have finite variance";
+    v.detail = "x, y and yaw must all have finite variance";
   } else {
     impl_->start(pose.stamp, std::get<UpdateRecord>(made));
-    v = {Outcome::kApplied, Reason::kNone, "initial pose", pose.stamp, 0.0,
-         "filter initialised at " + formatSeconds(pose.stamp)};
+    v = {Outcome::kApplied, Reason::kNone, InputKind::kInitialPose, "", pose.stamp, 0, 0.0, "filter initialised"};
   }
   return impl_->report(std::move(v));
 }

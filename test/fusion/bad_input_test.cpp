@@ -59,9 +59,9 @@ TEST_P(BadPoseInput, IsRejectedWithItsReasonAndLeavesTheStateBitIdentical) {
   const std::uint64_t count_before = rejectionsOf(localizer.counters(ndt), bad.reason);
   const Verdict v = localizer.feedPose(ndt, m);
   EXPECT_TRUE(v.rejected());
-  EXPECT_EQ(v.reason, bad.reason) << v.message;
-  EXPECT_NE(v.message.find(bad.says), std::string::npos) << v.message;
-  EXPECT_NE(v.message.find("'ndt'"), std::string::npos) << "the message must name the source: " << v.message;
+  EXPECT_EQ(v.reason, bad.reason) << v.message();
+  EXPECT_NE(v.message().find(bad.says), std::string::npos) << v.message();
+  EXPECT_NE(v.message().find("'ndt'"), std::string::npos) << "the message must name the source: " << v.message();
   EXPECT_EQ(rejectionsOf(localizer.counters(ndt), bad.reason), count_before + 1);
   EXPECT_TRUE(snapshot(localizer) == before);
   // And the filter still works afterwards.
@@ -99,7 +99,7 @@ TEST(BadInput, TwistWithNaNSpeedIsRejectedAndStateUnchanged) {
   const Snapshot before = snapshot(localizer);
   const Verdict v = localizer.feedTwist("odom", twist(kStart + kNow * kTick, kNaN, 0.1));
   EXPECT_EQ(v.reason, Reason::kInvalid);
-  EXPECT_NE(v.message.find("vx is not finite"), std::string::npos) << v.message;
+  EXPECT_NE(v.message().find("vx is not finite"), std::string::npos) << v.message();
   EXPECT_TRUE(snapshot(localizer) == before);
 }
 
@@ -128,7 +128,7 @@ TEST(BadInput, ClockGoingBackwardsIsRejectedAndStateUnchanged) {
   const Snapshot before = snapshot(localizer);
   const Verdict v = localizer.advanceTo(kStart + (kNow - 3) * kTick);
   EXPECT_EQ(v.reason, Reason::kClockBackwards);
-  EXPECT_NE(v.message.find("before the previous"), std::string::npos) << v.message;
+  EXPECT_NE(v.message().find("before the previous"), std::string::npos) << v.message();
   EXPECT_TRUE(snapshot(localizer) == before);
 }
 

@@ -22,7 +22,7 @@ TEST_P(DelayCompensation, LateMeasurementGivesTheSameEstimateAsOnTime) {
     if (k == stamp_tick) { EXPECT_TRUE(on_time.feedPose("ndt", ndtPoseAt(drive, stamp_tick)).applied()); }
     if (k == stamp_tick + late) {
       const Verdict v = delayed.feedPose("ndt", ndtPoseAt(drive, stamp_tick));
-      EXPECT_TRUE(v.applied()) << v.message;
+      EXPECT_TRUE(v.applied()) << v.message();
     }
   }
   expectSameEstimate(on_time, delayed, 1e-9);
@@ -54,14 +54,14 @@ TEST(DelayCompensation, DelayAtTheWindowEdgeIsAcceptedAndOneTickBeyondIsRejected
   const int window = localizer.config().history_steps;
   const Stamp newest = kStart + 80 * kTick;
   const Verdict at_edge = localizer.feedPose("rsu", fix2d(newest - window * kTick, 0, 0, 1.0e3));
-  EXPECT_TRUE(at_edge.applied()) << at_edge.message;
+  EXPECT_TRUE(at_edge.applied()) << at_edge.message();
   // Half a tick further still rounds to the edge tick; one nanosecond more does not.
   EXPECT_TRUE(localizer.feedPose("rsu", fix2d(newest - window * kTick - kTick / 2, 0, 0, 1.0e3)).applied());
   const Verdict beyond_rounding = localizer.feedPose("rsu", fix2d(newest - window * kTick - kTick / 2 - 1, 0, 0, 1.0e3));
-  EXPECT_EQ(beyond_rounding.reason, Reason::kTooOld) << beyond_rounding.message;
+  EXPECT_EQ(beyond_rounding.reason, Reason::kTooOld) << beyond_rounding.message();
   const Verdict one_beyond = localizer.feedPose("rsu", fix2d(newest - (window + 1) * kTick, 0, 0, 1.0e3));
   EXPECT_EQ(one_beyond.reason, Reason::kTooOld);
-  EXPECT_NE(one_beyond.message.find("history reaches back 1.000000000 s"), std::string::npos) << one_beyond.message;
+  EXPECT_NE(one_beyond.message().find("history reaches back 1.000000000 s"), std::string::npos) << one_beyond.message();
   EXPECT_EQ(localizer.counters(*localizer.findSource("rsu")).too_old, 2u);
 }
 
@@ -120,7 +120,7 @@ TEST(DelayCompensation, FixStampedAheadWithinToleranceWaitsForItsTickThenEqualsO
   PoseMeasurement fix = rsuFixAt(drive, 31);
   fix.stamp -= 5'000'000;
   const Verdict v = early.feedPose("rsu", fix);
-  EXPECT_EQ(v.outcome, Outcome::kPending) << v.message;
+  EXPECT_EQ(v.outcome, Outcome::kPending) << v.message();
   EXPECT_EQ(early.counters(*early.findSource("rsu")).pending, 1u);
   for (int k = 31; k <= 40; ++k) {
     driveTick(early, drive, k);

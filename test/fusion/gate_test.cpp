@@ -24,7 +24,7 @@ TEST(Gate, RejectsATenSigmaOutlierAndLeavesTheStateUnchanged) {
   Localizer localizer = startedLocalizer();
   const Snapshot before = snapshot(localizer);
   const Verdict v = localizer.feedPose("ndt", offsetAlongX(localizer, 10.0));
-  EXPECT_EQ(v.reason, Reason::kGated) << v.message;
+  EXPECT_EQ(v.reason, Reason::kGated) << v.message();
   EXPECT_NEAR(v.mahalanobis_squared, 100.0, 1e-9);
   EXPECT_TRUE(snapshot(localizer) == before);
   EXPECT_EQ(localizer.counters(*localizer.findSource("ndt")).gated, 1u);
@@ -33,7 +33,7 @@ TEST(Gate, RejectsATenSigmaOutlierAndLeavesTheStateUnchanged) {
 TEST(Gate, AcceptsAOneSigmaMeasurement) {
   Localizer localizer = startedLocalizer();
   const Verdict v = localizer.feedPose("ndt", offsetAlongX(localizer, 1.0));
-  EXPECT_TRUE(v.applied()) << v.message;
+  EXPECT_TRUE(v.applied()) << v.message();
   EXPECT_NEAR(v.mahalanobis_squared, 1.0, 1e-9);
 }
 
@@ -56,7 +56,7 @@ TEST(Gate, IncludesTheMeasurementCovarianceInS) {
 TEST(Gate, TwistGateRejectsAnImpossibleSpeed) {
   Localizer localizer = startedLocalizer();
   const Verdict v = localizer.feedTwist("odom", twist(kStart, 300.0, 0.0, 0.01, 0.01));
-  EXPECT_EQ(v.reason, Reason::kGated) << v.message;
+  EXPECT_EQ(v.reason, Reason::kGated) << v.message();
 }
 
 }  // namespace

@@ -62,7 +62,7 @@ class AugmentedStateEkf {
     if (llt.info() != Eigen::Success) return false;
     const Eigen::MatrixXd K = llt.solve(G.transpose()).transpose();
     x_ += K * e;
-    P_ -= K * G.transpose();
+    P_.noalias() -= K * G.transpose();
     return true;
   }
 

@@ -24,16 +24,25 @@ enum class Reason : std::uint8_t {
 const char* toString(Outcome outcome);
 const char* toString(Reason reason);
 
+enum class InputKind : std::uint8_t { kPose, kTwist, kInitialPose, kClock };
+
+const char* toString(InputKind kind);
+
 struct Verdict {
   Outcome outcome = Outcome::kApplied;
   Reason reason = Reason::kNone;
+  InputKind input = InputKind::kPose;
   std::string source;   ///< the source's name ("" for clock calls)
-  Stamp stamp = 0;      ///< the input's stamp
+  Stamp stamp = 0;      ///< the input's stamp (the clock's new time for clock calls)
+  int ticks_back = -1;  ///< tick the measurement was applied at, counted back from the newest
   double mahalanobis_squared = 0.0;  ///< of the first use, when gated or applied
-  std::string message;  ///< human-readable: names the input and the reason
+  std::string detail;   ///< why it was rejected, or what else happened
 
   bool applied() const { return outcome == Outcome::kApplied; }
   bool rejected() const { return outcome == Outcome::kRejected; }
+  /// One line for people: names the input, its stamp, the outcome and the reason. Built on demand so
+  /// that the hot path never formats text.
+  std::string message() const;
 };
 
 /// Per-source tallies; every input lands in exactly one of the final counters or in `pending`.
