@@ -247,6 +247,10 @@ struct Localizer::Impl {
     if (const auto* why = std::get_if<std::string>(&made)) return reject(id, stamp, Reason::kInvalid, *why);
     const UpdateRecord& record = std::get<UpdateRecord>(made);
     if (!initialized) {
+      const Duration history_span = static_cast<Duration>(config.history_steps) * history.options().step;
+      if (clock_set && stamp < clock - history_span - history.options().step / 2)
+        return reject(id, stamp, Reason::kTooOld,
+                      "stamp is " + formatSeconds(clock - stamp) + " s behind the clock: too old to start the filter from");
       if (kind == SourceKind::kPose && config.auto_initialize && measuresPlanarPose(record)) {
         start(stamp, record);
         ++src.counters.applied;

@@ -74,11 +74,20 @@ TEST(McapReader, FirstAmclPoseDecodesToTheRecordedPose) {
   // Header stamps are simulation time, unlike the wall-clock log time.
   EXPECT_NEAR(toSeconds(pose.header.stamp), 924.102, 5e-4);
   EXPECT_EQ(pose.measurement.stamp, pose.header.stamp);
-  // Values as printed to 4-5 significant digits; tolerances are half a unit of the last digit.
+  // The recorded values: x 4.365196654, y 7.579351696, yaw 0.179605751 rad, cov_xx 0.028234069 m^2,
+  // cov_xy 0.007358 m^2. Decoding is exact, so the tolerances only absorb the nine printed decimals.
+  EXPECT_NEAR(pose.measurement.pose.position.x(), 4.365196654, 1e-9);
+  EXPECT_NEAR(pose.measurement.pose.position.y(), 7.579351696, 1e-9);
+  EXPECT_NEAR(rollPitchYaw(pose.measurement.pose.orientation).z(), 0.179605751, 1e-9);
+  EXPECT_NEAR(pose.measurement.covariance(0, 0), 0.028234069, 1e-9);
+  EXPECT_NEAR(pose.measurement.covariance(0, 1), 0.007358, 1e-6);
+  // What a log summary rounds them to.
   EXPECT_NEAR(pose.measurement.pose.position.x(), 4.3652, 5e-5);
   EXPECT_NEAR(pose.measurement.pose.position.y(), 7.5794, 5e-5);
   EXPECT_NEAR(rollPitchYaw(pose.measurement.pose.orientation).z(), 0.1796, 5e-5);
   EXPECT_NEAR(pose.measurement.covariance(0, 0), 0.02823, 5e-6);
+  // AMCL estimates x, y, yaw only: z, roll and pitch have zero variance in the message.
+  EXPECT_EQ(pose.measurement.covariance(2, 2), 0.0);
   EXPECT_NEAR(pose.measurement.pose.orientation.norm(), 1.0, 1e-9);
   EXPECT_EQ(pose.measurement.covariance, pose.measurement.covariance.transpose());
 }

@@ -1,0 +1,49 @@
+#include "coloc/fusion/ekf_params.hpp"
+
+#include <cstdio>
+
+namespace coloc::fusion {
+
+const std::vector<EkfParam>& ekfParams() {
+  using C = EkfConfig;
+  static const std::vector<EkfParam> params = {
+      {"predict_frequency", "Hz", "fixed prediction rate, on the caller's clock (log time offline)", &C::predict_frequency},
+      {"history_steps", "ticks", "how far back a delayed measurement is still applied exactly (50 = 1 s)", &C::history_steps},
+      {"relinearize_on_replay", "", "re-evaluate the motion model when replaying after a late measurement (exact); false reproduces Autoware's augmented filter", &C::relinearize_on_replay},
+      {"enable_yaw_bias_estimation", "", "estimate a constant offset between measured yaw and direction of motion", &C::enable_yaw_bias_estimation},
+      {"proc_stddev_yaw_c", "rad/s", "yaw process noise; Q = (c dt)^2", &C::proc_stddev_yaw_c},
+      {"proc_stddev_vx_c", "m/s^2", "speed process noise", &C::proc_stddev_vx_c},
+      {"proc_stddev_wz_c", "rad/s^2", "yaw-rate process noise", &C::proc_stddev_wz_c},
+      {"pose_smoothing_steps", "ticks", "a pose is applied over this many ticks, each with covariance x steps", &C::pose_smoothing_steps},
+      {"max_pose_queue_size", "poses", "poses of one source being smoothed at once; the oldest is folded in when full", &C::max_pose_queue_size},
+      {"twist_smoothing_steps", "ticks", "as pose_smoothing_steps, for twists", &C::twist_smoothing_steps},
+      {"max_twist_queue_size", "twists", "as max_pose_queue_size, for twists", &C::max_twist_queue_size},
+      {"pose_gate_alpha", "", "chance a correct pose is gated: d^2 = e' S^-1 e against the chi-square (1 - alpha) quantile; 0 = no gate", &C::pose_gate_alpha},
+      {"twist_gate_alpha", "", "as pose_gate_alpha, for twists", &C::twist_gate_alpha},
+      {"z_filter_proc_dev", "m/s", "random walk of the separate z filter", &C::z_filter_proc_dev},
+      {"roll_filter_proc_dev", "rad/s", "random walk of the separate roll filter", &C::roll_filter_proc_dev},
+      {"pitch_filter_proc_dev", "rad/s", "random walk of the separate pitch filter", &C::pitch_filter_proc_dev},
+      {"threshold_observable_velocity_mps", "m/s", "below this speed a twist's vx variance becomes 10000; 0 = off", &C::threshold_observable_velocity_mps},
+      {"future_tolerance", "s", "a stamp ahead of the clock by more than this is rejected; within it, it waits for its tick", &C::future_tolerance},
+      {"initial_yaw_bias_variance", "rad^2", "yaw-bias variance at initialisation", &C::initial_yaw_bias_variance},
+      {"initial_vx_variance", "(m/s)^2", "speed variance at initialisation (an initial pose says nothing of speed)", &C::initial_vx_variance},
+      {"initial_wz_variance", "(rad/s)^2", "yaw-rate variance at initialisation", &C::initial_wz_variance},
+      {"auto_initialize", "", "the first pose measuring x, y and yaw initialises the filter", &C::auto_initialize},
+  };
+  return params;
+}
+
+std::string formatValue(const EkfParam& param, const EkfConfig& config) {
+  char buffer[64];
+  if (const auto* d = std::get_if<double EkfConfig::*>(&param.field)) {
+    std::snprintf(buffer, sizeof buffer, "%.10g", config.*(*d));
+    std::string text = buffer;
+    // YAML 1.2 reads "50" as an integer; keep floats recognisable as floats.
+    if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+    return text;
+  }
+  if (const auto* i = std::get_if<int EkfConfig::*>(&param.field)) return std::to_string(config.*(*i));
+  return config.*std::get<bool EkfConfig::*>(param.field) ? "true" : "false";
+}
+
+}  // namespace coloc::fusion

@@ -1,0 +1,47 @@
+#pragma once
+// Reads ROS 2 recordings without ROS: a .mcap file, a .db3 file, or a rosbag2 directory (metadata.yaml
+// naming one or several sqlite3 or mcap files). Messages come in file order (sqlite3: by timestamp,
+// then row id; MCAP: as written), one file after the other, streamed: an MCAP file is read chunk by
+// chunk, never whole.
+//
+// All failures throw coloc::Error naming the file (and byte offset or row where it applies) and the
+// reason: bad magic, truncated records, CRC mismatch, unknown compression, a message on an unknown
+// channel, a missing file, unreadable metadata.yaml, ...
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coloc/io/bag_message.hpp"
+
+namespace coloc::io {
+
+class BagReader {
+ public:
+  /// Opens and indexes the bag (topics, message counts). Throws coloc::Error.
+  static BagReader open(const std::string& path);
+
+  ~BagReader();
+  BagReader(BagReader&&) noexcept;
+  BagReader& operator=(BagReader&&) noexcept;
+
+  /// The path given to open().
+  const std::string& path() const;
+  /// "mcap" or "sqlite3".
+  const std::string& storageIdentifier() const;
+  /// The storage files read, in order.
+  const std::vector<std::string>& files() const;
+  /// Topics in the order the bag lists them, counts summed over all files.
+  const std::vector<TopicInfo>& topics() const;
+  std::uint64_t messageCount() const;
+
+  /// Fills `message` with the next message and returns true, or returns false at the end.
+  /// Reuses message.data's capacity. Throws coloc::Error on corrupt data.
+  bool next(BagMessage& message);
+
+ private:
+  struct Impl;
+  explicit BagReader(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace coloc::io

@@ -1,0 +1,57 @@
+#pragma once
+// Writes rosbag2 sqlite3 bags that ROS 2 Humble and Jazzy play and inspect (`ros2 bag play`,
+// `ros2 bag info`): a directory OUT/ holding OUT_0.db3 (database schema 3: schema, metadata, topics,
+// messages, index on timestamp) and metadata.yaml (version 5). All messages go in one transaction,
+// committed by close(). And convert(): any bag BagReader reads -> sqlite3 directory or .mcap file.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coloc/io/bag_message.hpp"
+#include "coloc/io/mcap_writer.hpp"
+
+namespace coloc::io {
+
+class BagWriter {
+ public:
+  /// Creates the bag directory (and its parents); refuses an existing non-empty directory or a file.
+  static BagWriter create(const std::string& directory);
+
+  ~BagWriter();  ///< closes if close() was not called, swallowing errors: call close() to see them
+  BagWriter(BagWriter&&) noexcept;
+  BagWriter& operator=(BagWriter&&) noexcept;
+
+  /// Declares a topic (its message_count is ignored). The QoS profiles are stored in the v5 form
+  /// (numeric enums) Humble reads; a topic without them gets RELIABLE / VOLATILE / KEEP_LAST 10.
+  void addTopic(const TopicInfo& topic);
+  void write(const std::string& topic, Stamp log_time, const std::uint8_t* data, std::size_t size);
+  void write(const BagMessage& message);
+  /// Commits the messages, writes the metadata row and metadata.yaml. Throws coloc::Error.
+  void close();
+
+  /// The database file, e.g. "OUT/OUT_0.db3".
+  const std::string& databasePath() const;
+
+ private:
+  struct Impl;
+  explicit BagWriter(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+struct ConvertOptions {
+  McapWriterOptions mcap;  ///< used when the output is a .mcap file
+};
+
+struct ConvertSummary {
+  std::vector<TopicInfo> topics;
+  std::uint64_t message_count = 0;
+};
+
+/// Copies every message of `input` (anything BagReader::open accepts) to `output`: an MCAP file if the
+/// name ends in ".mcap", else a rosbag2 sqlite3 directory. Payload bytes and log times are preserved
+/// exactly; MCAP publish times too when both sides are MCAP. Refuses to overwrite existing output.
+ConvertSummary convert(const std::string& input, const std::string& output, const ConvertOptions& options = {});
+
+}  // namespace coloc::io

@@ -1,0 +1,24 @@
+#pragma once
+// One storage file of a bag (an MCAP file or a sqlite3 database), as BagReader composes them.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coloc/io/bag_message.hpp"
+
+namespace coloc::io::detail {
+
+class StorageReader {
+ public:
+  virtual ~StorageReader() = default;
+  /// Topics with their message counts in this file.
+  virtual const std::vector<TopicInfo>& topics() const = 0;
+  /// Next message in file order; false at the end. message.index is left to the caller.
+  virtual bool next(BagMessage& message) = 0;
+};
+
+/// Throw coloc::Error naming the file and the reason.
+std::unique_ptr<StorageReader> openMcapStorage(const std::string& path);
+std::unique_ptr<StorageReader> openSqliteStorage(const std::string& path);
+
+}  // namespace coloc::io::detail

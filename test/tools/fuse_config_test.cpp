@@ -1,0 +1,101 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "coloc/core/error.hpp"
+#include "fuse_config.hpp"
+
+namespace coloc::tools {
+namespace {
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void expectError(const std::string& yaml, const std::string& phrase) {
+  try {
+    parseFuseConfig(yaml, "test.yaml");
+    FAIL() << "expected an error containing '" << phrase << "'";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
+  }
+}
+
+TEST(FuseConfig, ShippedDefaultFileIsExactlyTheGeneratedDefaults) {
+  EXPECT_EQ(readFile(COLOC_SOURCE_DIR "/config/coloc.yaml"), defaultConfigYaml())
+      << "regenerate it: coloc config > config/coloc.yaml";
+}
+
+TEST(FuseConfig, ReadmeCarriesTheGeneratedReferenceTable) {
+  EXPECT_NE(readFile(COLOC_SOURCE_DIR "/README.md").find(configReferenceMarkdown()), std::string::npos)
+      << "regenerate the README table: coloc config --markdown";
+}
+
+TEST(FuseConfig, DefaultYamlParsesBackToTheDefaults) {
+  const FuseConfig parsed = parseFuseConfig(defaultConfigYaml(), "defaults");
+  EXPECT_EQ(parsed.fusion.predict_frequency, 50.0);
+  EXPECT_EQ(parsed.fusion.history_steps, 50);
+  EXPECT_EQ(parsed.fusion.pose_gate_alpha, 1e-10);
+  EXPECT_EQ(parsed.replay.fallback_twist_variance[1], kInfinity);
+  EXPECT_TRUE(parsed.inputs.empty());
+}
+
+TEST(FuseConfig, EmptyTextIsTheDefaultConfiguration) {
+  EXPECT_EQ(parseFuseConfig("", "empty").fusion.pose_smoothing_steps, 5);
+}
+
+TEST(FuseConfig, ReadsInputsWithTheirRolesAndOverrides) {
+  const FuseConfig c = parseFuseConfig(
+      "inputs:\n"
+      "  /odom: {role: twist, covariance_diagonal: [0.01, .inf, .inf, .inf, .inf, 0.0025]}\n"
+      "  /rsu/fix: {role: pose, source: rsu_a, additional_delay: 0.01}\n"
+      "fusion:\n  pose_smoothing_steps: 3\n",
+      "test.yaml");
+  EXPECT_EQ(c.inputs.at("/odom").role, InputRole::kTwist);
+  EXPECT_EQ(c.inputs.at("/odom").source, "/odom");
+  EXPECT_EQ((*c.inputs.at("/odom").covariance_diagonal)[5], 0.0025);
+  EXPECT_EQ(c.inputs.at("/rsu/fix").source, "rsu_a");
+  EXPECT_EQ(c.inputs.at("/rsu/fix").additional_delay, 0.01);
+  EXPECT_EQ(c.fusion.pose_smoothing_steps, 3);
+}
+
+TEST(FuseConfig, UnknownKeysAreErrorsNamingKeyAndLine) {
+  expectError("fusion:\n  history_step: 50\n", "test.yaml:2: fusion.history_step: unknown key");
+  expectError("fusoin: {}\n", "fusoin: unknown section");
+  expectError("inputs:\n  /odom: {role: twist, sigma: 1}\n", "inputs./odom.sigma: unknown key");
+  expectError("replay:\n  clocks: same\n", "replay.clocks: unknown key");
+}
+
+TEST(FuseConfig, WrongTypesAndRangesAreErrorsNamingTheKey) {
+  expectError("fusion:\n  predict_frequency: fast\n", "fusion.predict_frequency: expected a number");
+  expectError("fusion:\n  history_steps: 2.5\n", "fusion.history_steps: expected an integer");
+  expectError("fusion:\n  predict_frequency: -1\n", "predict_frequency");
+  expectError("fusion:\n  pose_gate_alpha: .nan\n", "must not be NaN");
+  expectError("inputs:\n  /odom: {role: velocity}\n", "expected pose, twist, ground_truth or ignore");
+  expectError("inputs:\n  /odom: {source: x}\n", "needs a role");
+  expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, 2]}\n", "expected 6 variances");
+  expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, -2, 1, 1, 1, 1]}\n", "must be > 0");
+  expectError("replay:\n  clock: sometimes\n", "expected auto, same or separate");
+  expectError("fusion: [1, 2]\n", "expected a mapping");
+  expectError("fusion:\n  a: [\n", "not valid YAML");
+}
+
+TEST(FuseConfig, TwoInputsWithOneSourceNameAreAnError) {
+  expectError("inputs:\n  /a: {role: pose, source: x}\n  /b: {role: pose, source: x}\n", "used by two inputs");
+}
+
+TEST(FuseConfig, MissingFileIsAnErrorNamingIt) {
+  try {
+    loadFuseConfig("/nonexistent/coloc.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/coloc.yaml"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace coloc::tools

@@ -1,0 +1,11 @@
+#pragma once
+// The subcommands of `coloc`, each registered on the CLI11 app by its own file.
+#include <CLI/CLI.hpp>
+
+namespace coloc::tools {
+
+void addFuseCommand(CLI::App& app);
+void addConvertCommand(CLI::App& app);
+void addConfigCommand(CLI::App& app);
+
+}  // namespace coloc::tools

@@ -1,0 +1,26 @@
+// `coloc config`: prints the default configuration (YAML) or the reference table (Markdown), or checks
+// a configuration file.
+#include <cstdio>
+
+#include "commands.hpp"
+#include "fuse_config.hpp"
+
+namespace coloc::tools {
+
+void addConfigCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("config", "Print the default configuration, its reference table, or check a file");
+  static bool markdown = false;
+  static std::string check;
+  cmd->add_flag("--markdown", markdown, "print the README's reference table instead of YAML");
+  cmd->add_option("--check", check, "validate this YAML file and exit")->check(CLI::ExistingFile);
+  cmd->callback([] {
+    if (!check.empty()) {
+      loadFuseConfig(check);
+      std::printf("%s: valid\n", check.c_str());
+      return;
+    }
+    std::fputs((markdown ? configReferenceMarkdown() : defaultConfigYaml()).c_str(), stdout);
+  });
+}
+
+}  // namespace coloc::tools

@@ -1,0 +1,200 @@
+// `coloc fuse LOG`: replays a recording through the filter and writes the fused trajectory, a summary
+// and plots.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "coloc/core/error.hpp"
+#include "commands.hpp"
+#include "log_replay.hpp"
+#include "progress.hpp"
+#include "svg_plot.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ErrorStats {
+  double mean = 0.0, rmse = 0.0, max = 0.0;
+};
+
+ErrorStats errorStats(const std::vector<ErrorSample>& errors) {
+  ErrorStats s;
+  for (const ErrorSample& e : errors) {
+    s.mean += e.error;
+    s.rmse += e.error * e.error;
+    s.max = std::max(s.max, e.error);
+  }
+  if (!errors.empty()) {
+    s.mean /= errors.size();
+    s.rmse = std::sqrt(s.rmse / errors.size());
+  }
+  return s;
+}
+
+nlohmann::ordered_json countersJson(const fusion::SourceCounters& c) {
+  return {{"received", c.received},   {"applied", c.applied},         {"gated", c.gated},
+          {"too_old", c.too_old},     {"from_future", c.from_future}, {"invalid", c.invalid},
+          {"not_initialized", c.not_initialized}, {"numerical", c.numerical}, {"pending", c.pending},
+          {"smoothing_shortened", c.smoothing_shortened}};
+}
+
+// Everything in summary.json is a function of the log and the config, so that reruns give the same
+// bytes; run times go to timing.json.
+nlohmann::ordered_json summaryJson(const std::string& log, const ReplayResult& r) {
+  nlohmann::ordered_json j;
+  j["log"] = log;
+  j["messages"] = r.messages_read;
+  j["log_duration_s"] = r.log_duration;
+  j["clock"] = {{"mode", r.clock == ClockMode::kSeparate ? "separate" : "same"}};
+  if (r.clock == ClockMode::kSeparate) {
+    j["clock"]["rate"] = r.clock_fit.rate;
+    j["clock"]["log_origin"] = formatSeconds(r.clock_fit.log_origin);
+    j["clock"]["stamp_origin"] = formatSeconds(r.clock_fit.stamp_origin);
+  }
+  auto& topics = j["topics"] = nlohmann::ordered_json::array();
+  for (const TopicUse& t : r.topics) {
+    nlohmann::ordered_json o = {{"topic", t.topic}, {"type", t.type}, {"role", toString(t.role)}, {"messages", t.messages}};
+    if (t.role == InputRole::kPose || t.role == InputRole::kTwist) o["source"] = t.source;
+    if (t.role != InputRole::kIgnore) {
+      o["decode_errors"] = t.decode_errors;
+      o["fallback_covariance"] = t.fallback_covariance;
+      o["delay_median_s"] = t.delay_median;
+      o["delay_max_s"] = t.delay_max;
+    }
+    if (!t.first_error.empty()) o["first_error"] = t.first_error;
+    if (!t.note.empty()) o["note"] = t.note;
+    topics.push_back(o);
+  }
+  auto& sources = j["sources"] = nlohmann::ordered_json::array();
+  for (const auto& s : r.sources)
+    sources.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"},
+                       {"counters", countersJson(s.counters)}});
+  j["fused"] = {{"file", "fused.tum"}, {"poses", r.fused.size()},
+                {"first_stamp", formatSeconds(r.first_stamp)}, {"last_stamp", formatSeconds(r.last_stamp)}};
+  if (!r.errors.empty()) {
+    const ErrorStats s = errorStats(r.errors);
+    j["position_error"] = {{"samples", r.errors.size()}, {"mean_m", s.mean}, {"rmse_m", s.rmse}, {"max_m", s.max},
+                           {"file", "error.csv"}};
+  } else {
+    j["position_error"] = nullptr;
+  }
+  j["rejections_first"] = r.rejections;
+  return j;
+}
+
+void printSummary(const std::string& log, const ReplayResult& r, const std::string& out_dir) {
+  std::printf("coloc fuse %s\n", log.c_str());
+  std::printf("  %llu messages over %.1f s of log; clock: %s", static_cast<unsigned long long>(r.messages_read), r.log_duration,
+              r.clock == ClockMode::kSeparate ? "header stamps and log times on different clocks" : "one clock");
+  if (r.clock == ClockMode::kSeparate)
+    std::printf("\n  (stamp clock runs at %.5f x log time; delays measured from the fitted relation, the shortest about 0)",
+                r.clock_fit.rate);
+  std::printf("\n\n  %-22s %-44s %-13s %9s %12s\n", "topic", "type", "role", "messages", "delay median");
+  for (const TopicUse& t : r.topics) {
+    std::printf("  %-22s %-44s %-13s %9llu", t.topic.c_str(), t.type.c_str(), toString(t.role),
+                static_cast<unsigned long long>(t.messages));
+    if (t.role != InputRole::kIgnore) std::printf(" %9.1f ms", 1e3 * t.delay_median);
+    if (!t.note.empty()) std::printf("  (%s)", t.note.c_str());
+    if (t.decode_errors) std::printf("  %llu undecodable", static_cast<unsigned long long>(t.decode_errors));
+    if (t.fallback_covariance) std::printf("  %llu without covariance: fallback used", static_cast<unsigned long long>(t.fallback_covariance));
+    std::printf("\n");
+  }
+  std::printf("\n  %-22s %8s %8s %7s %7s %7s %7s %8s %7s\n", "source", "received", "applied", "gated", "too_old", "future",
+              "invalid", "no_init", "pending");
+  for (const auto& s : r.sources) {
+    const auto& c = s.counters;
+    std::printf("  %-22s %8llu %8llu %7llu %7llu %7llu %7llu %8llu %7llu\n", s.name.c_str(), (unsigned long long)c.received,
+                (unsigned long long)c.applied, (unsigned long long)c.gated, (unsigned long long)c.too_old,
+                (unsigned long long)c.from_future, (unsigned long long)c.invalid, (unsigned long long)c.not_initialized,
+                (unsigned long long)c.pending);
+  }
+  for (const TopicUse& t : r.topics)
+    if (!t.first_error.empty()) std::printf("  first decode error: %s\n", t.first_error.c_str());
+  if (!r.errors.empty()) {
+    const ErrorStats s = errorStats(r.errors);
+    std::printf("\n  position error vs ground truth (%zu ticks): mean %.4f m, RMSE %.4f m, max %.4f m\n", r.errors.size(), s.mean,
+                s.rmse, s.max);
+  } else {
+    std::printf("\n  no ground truth in the log: no error figures\n");
+  }
+  std::printf("  fused %zu poses (%.1f s) in %.3f s: %.0fx real time\n", r.fused.size(), toSeconds(r.last_stamp - r.first_stamp),
+              r.wall_seconds, r.wall_seconds > 0 ? r.log_duration / r.wall_seconds : 0.0);
+  std::printf("  wrote %s/{fused.tum, summary.json, trajectory.svg%s}\n", out_dir.c_str(), r.errors.empty() ? "" : ", error.csv, error.svg");
+}
+
+void writePlots(const ReplayResult& r, const std::string& dir, const std::string& log) {
+  Plot map;
+  map.title = "Trajectory: " + fs::path(log).filename().string();
+  map.x_label = "x [m]";
+  map.y_label = "y [m]";
+  map.equal_aspect = true;
+  auto series = [](const std::vector<io::TrajectoryPoint>& points, std::string label, std::string color, bool dots) {
+    PlotSeries s{std::move(label), {}, {}, std::move(color), dots};
+    for (const auto& p : points) s.x.push_back(p.pose.position.x()), s.y.push_back(p.pose.position.y());
+    return s;
+  };
+  if (!r.ground_truth.empty()) map.series.push_back(series(r.ground_truth, "ground truth", "#333333", false));
+  map.series.push_back(series(r.pose_inputs, "pose measurements", "#ff7f0e", true));
+  map.series.push_back(series(r.fused, "fused", "#1f77b4", false));
+  writeSvg(dir + "/trajectory.svg", map);
+  if (r.errors.empty()) return;
+  Plot error;
+  error.title = "Position error against ground truth";
+  error.x_label = "time since start [s]";
+  error.y_label = "planar error [m]";
+  error.y_from_zero = true;
+  PlotSeries e{"fused", {}, {}, "#1f77b4", false};
+  for (const ErrorSample& s : r.errors) e.x.push_back(toSeconds(s.stamp - r.errors.front().stamp)), e.y.push_back(s.error);
+  error.series.push_back(e);
+  writeSvg(dir + "/error.svg", error);
+}
+
+void writeErrorCsv(const ReplayResult& r, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot write");
+  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m\n";
+  char line[256];
+  for (const ErrorSample& s : r.errors) {
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(), s.estimate.y(),
+                  s.truth.x(), s.truth.y(), s.error);
+    out << line;
+  }
+}
+
+}  // namespace
+
+void addFuseCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("fuse", "Fuse a recorded ROS 2 log (.mcap, .db3 or rosbag2 folder) and write the trajectory");
+  static std::string log, config_path, out_dir = "coloc_out";
+  cmd->add_option("LOG", log, "the recording")->required();
+  cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`)")->check(CLI::ExistingFile);
+  cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
+  cmd->callback([] {
+    ReplayOptions options;
+    if (!config_path.empty()) options.config = loadFuseConfig(config_path);
+    ProgressBar progress("fusing");
+    options.progress = [&](double f) { progress.update(f); };
+    const ReplayResult result = replayLog(log, options);
+    progress.finish();
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    io::writeTumTrajectory(out_dir + "/fused.tum", result.fused,
+                           "coloc fused trajectory of " + fs::path(log).filename().string() +
+                               "\nt x y z qx qy qz qw (t: header-stamp clock, s)");
+    std::ofstream(out_dir + "/summary.json") << summaryJson(log, result).dump(2) << "\n";
+    nlohmann::ordered_json timing = {{"replay_wall_s", result.wall_seconds},
+                                     {"speed_x_realtime", result.wall_seconds > 0 ? result.log_duration / result.wall_seconds : 0.0}};
+    std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
+    if (!result.errors.empty()) writeErrorCsv(result, out_dir + "/error.csv");
+    writePlots(result, out_dir, log);
+    printSummary(log, result, out_dir);
+  });
+}
+
+}  // namespace coloc::tools

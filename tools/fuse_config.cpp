@@ -1,0 +1,288 @@
+#include "fuse_config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "coloc/core/error.hpp"
+#include "coloc/fusion/ekf_params.hpp"
+#include "coloc/fusion/localizer.hpp"
+
+namespace coloc::tools {
+
+const char* toString(InputRole role) {
+  switch (role) {
+    case InputRole::kPose: return "pose";
+    case InputRole::kTwist: return "twist";
+    case InputRole::kGroundTruth: return "ground_truth";
+    case InputRole::kIgnore: return "ignore";
+  }
+  return "?";
+}
+
+namespace {
+
+const char* toString(ClockMode mode) {
+  switch (mode) {
+    case ClockMode::kAuto: return "auto";
+    case ClockMode::kSame: return "same";
+    case ClockMode::kSeparate: return "separate";
+  }
+  return "?";
+}
+
+// Names a node's place in the file for error messages.
+class Context {
+ public:
+  explicit Context(std::string source) : source_(std::move(source)) {}
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& key, const std::string& why) const {
+    std::ostringstream out;
+    out << source_;
+    if (node.Mark().line >= 0) out << ":" << node.Mark().line + 1;
+    out << ": " << key << ": " << why;
+    throw Error(out.str());
+  }
+  template <typename T>
+  T read(const YAML::Node& node, const std::string& key, const char* what) const {
+    try {
+      return node.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(node, key, std::string("expected ") + what);
+    }
+  }
+  double readDouble(const YAML::Node& node, const std::string& key) const {
+    const double v = read<double>(node, key, "a number");
+    if (std::isnan(v)) fail(node, key, "must not be NaN");
+    return v;
+  }
+
+ private:
+  std::string source_;
+};
+
+void requireMap(const Context& ctx, const YAML::Node& node, const std::string& key) {
+  if (!node.IsMap()) ctx.fail(node, key, "expected a mapping of keys to values");
+}
+
+void readFusion(const Context& ctx, const YAML::Node& node, fusion::EkfConfig& config) {
+  requireMap(ctx, node, "fusion");
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const fusion::EkfParam* param = nullptr;
+    for (const auto& p : fusion::ekfParams())
+      if (key == p.key) param = &p;
+    if (!param) ctx.fail(entry.first, "fusion." + key, "unknown key (see `coloc config` for the valid ones)");
+    const std::string full = "fusion." + key;
+    if (const auto* d = std::get_if<double fusion::EkfConfig::*>(&param->field)) {
+      config.*(*d) = ctx.readDouble(entry.second, full);
+    } else if (const auto* i = std::get_if<int fusion::EkfConfig::*>(&param->field)) {
+      config.*(*i) = ctx.read<int>(entry.second, full, "an integer");
+    } else {
+      config.*std::get<bool fusion::EkfConfig::*>(param->field) = ctx.read<bool>(entry.second, full, "true or false");
+    }
+  }
+  try {
+    fusion::Localizer probe(config);  // the filter's own range checks, reported against the file
+  } catch (const Error& e) {
+    ctx.fail(node, "fusion", e.what());
+  }
+}
+
+Vector6d readVariances(const Context& ctx, const YAML::Node& node, const std::string& key) {
+  if (!node.IsSequence() || node.size() != 6)
+    ctx.fail(node, key, "expected 6 variances [x, y, z, roll, pitch, yaw] or [vx, vy, vz, wx, wy, wz]; .inf = not measured");
+  Vector6d v;
+  for (int i = 0; i < 6; ++i) {
+    v[i] = ctx.readDouble(node[i], key);
+    if (!(v[i] > 0.0)) ctx.fail(node[i], key, "variances must be > 0 (.inf for not measured)");
+  }
+  return v;
+}
+
+InputConfig readInput(const Context& ctx, const std::string& topic, const YAML::Node& node) {
+  const std::string where = "inputs." + topic;
+  requireMap(ctx, node, where);
+  InputConfig input;
+  bool has_role = false;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const std::string full = where + "." + key;
+    if (key == "role") {
+      const std::string role = ctx.read<std::string>(entry.second, full, "a string");
+      if (role == "pose") input.role = InputRole::kPose;
+      else if (role == "twist") input.role = InputRole::kTwist;
+      else if (role == "ground_truth") input.role = InputRole::kGroundTruth;
+      else if (role == "ignore") input.role = InputRole::kIgnore;
+      else ctx.fail(entry.second, full, "expected pose, twist, ground_truth or ignore, got '" + role + "'");
+      has_role = true;
+    } else if (key == "source") {
+      input.source = ctx.read<std::string>(entry.second, full, "a string");
+    } else if (key == "covariance_diagonal") {
+      input.covariance_diagonal = readVariances(ctx, entry.second, full);
+    } else if (key == "additional_delay") {
+      input.additional_delay = ctx.readDouble(entry.second, full);
+      if (!(input.additional_delay >= 0.0 && input.additional_delay < 10.0)) ctx.fail(entry.second, full, "must be in [0, 10) s");
+    } else {
+      ctx.fail(entry.first, full, "unknown key (role, source, covariance_diagonal, additional_delay)");
+    }
+  }
+  if (!has_role) ctx.fail(node, where, "needs a role: pose, twist, ground_truth or ignore");
+  if (input.source.empty()) input.source = topic;
+  return input;
+}
+
+void readReplay(const Context& ctx, const YAML::Node& node, ReplayConfig& replay) {
+  requireMap(ctx, node, "replay");
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const std::string full = "replay." + key;
+    if (key == "clock") {
+      const std::string mode = ctx.read<std::string>(entry.second, full, "a string");
+      if (mode == "auto") replay.clock = ClockMode::kAuto;
+      else if (mode == "same") replay.clock = ClockMode::kSame;
+      else if (mode == "separate") replay.clock = ClockMode::kSeparate;
+      else ctx.fail(entry.second, full, "expected auto, same or separate, got '" + mode + "'");
+    } else if (key == "zero_variance_is_unmeasured") {
+      replay.zero_variance_is_unmeasured = ctx.read<bool>(entry.second, full, "true or false");
+    } else if (key == "fallback_pose_variance") {
+      replay.fallback_pose_variance = readVariances(ctx, entry.second, full);
+    } else if (key == "fallback_twist_variance") {
+      replay.fallback_twist_variance = readVariances(ctx, entry.second, full);
+    } else if (key == "ground_truth_max_gap") {
+      replay.ground_truth_max_gap = ctx.readDouble(entry.second, full);
+      if (!(replay.ground_truth_max_gap > 0.0 && replay.ground_truth_max_gap <= 10.0))
+        ctx.fail(entry.second, full, "must be in (0, 10] s");
+    } else {
+      ctx.fail(entry.first, full, "unknown key (see `coloc config`)");
+    }
+  }
+}
+
+std::string yamlNumber(double v) {
+  if (v == kInfinity) return ".inf";
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+std::string yamlList(const Vector6d& v) {
+  std::string s = "[";
+  for (int i = 0; i < 6; ++i) s += (i ? ", " : "") + yamlNumber(v[i]);
+  return s + "]";
+}
+
+struct ReplayKey {
+  const char* key;
+  const char* unit;
+  const char* meaning;
+  std::string (*value)(const ReplayConfig&);
+};
+
+const std::vector<ReplayKey>& replayKeys() {
+  static const std::vector<ReplayKey> keys = {
+      {"clock", "", "auto, same or separate: are header stamps and log times on one clock? auto decides from the data",
+       [](const ReplayConfig& r) { return std::string(toString(r.clock)); }},
+      {"zero_variance_is_unmeasured", "", "read a 0 variance in a message as +inf, as ROS drivers write 0 for what they do not estimate",
+       [](const ReplayConfig& r) { return std::string(r.zero_variance_is_unmeasured ? "true" : "false"); }},
+      {"fallback_pose_variance", "m^2, rad^2", "pose covariance diagonal for messages that carry none (Autoware's NDT value)",
+       [](const ReplayConfig& r) { return yamlList(r.fallback_pose_variance); }},
+      {"fallback_twist_variance", "(m/s)^2, (rad/s)^2", "twist covariance diagonal for messages that carry none (Autoware's 0.2 m/s, 0.1 rad/s)",
+       [](const ReplayConfig& r) { return yamlList(r.fallback_twist_variance); }},
+      {"ground_truth_max_gap", "s", "ground truth is interpolated to the filter's ticks only across gaps up to this",
+       [](const ReplayConfig& r) { return yamlNumber(r.ground_truth_max_gap); }},
+  };
+  return keys;
+}
+
+}  // namespace
+
+FuseConfig parseFuseConfig(const std::string& yaml_text, const std::string& source_name) {
+  const Context ctx(source_name);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw Error(source_name + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+  FuseConfig config;
+  if (root.IsNull()) return config;
+  requireMap(ctx, root, "(top level)");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    if (key == "fusion") {
+      readFusion(ctx, entry.second, config.fusion);
+    } else if (key == "inputs") {
+      if (entry.second.IsNull()) continue;
+      requireMap(ctx, entry.second, "inputs");
+      for (const auto& input : entry.second) {
+        const std::string topic = input.first.as<std::string>();
+        config.inputs[topic] = readInput(ctx, topic, input.second);
+      }
+    } else if (key == "replay") {
+      readReplay(ctx, entry.second, config.replay);
+    } else {
+      ctx.fail(entry.first, key, "unknown section (fusion, inputs, replay)");
+    }
+  }
+  std::set<std::string> sources;
+  for (const auto& [topic, input] : config.inputs)
+    if ((input.role == InputRole::kPose || input.role == InputRole::kTwist) && !sources.insert(input.source).second)
+      throw Error(source_name + ": inputs." + topic + ".source: '" + input.source + "' is used by two inputs");
+  return config;
+}
+
+FuseConfig loadFuseConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the config file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseFuseConfig(text.str(), path);
+}
+
+std::string defaultConfigYaml() {
+  const FuseConfig defaults;
+  std::ostringstream out;
+  out << "# coloc configuration: every key with its default. Any key may be left out.\n"
+         "# Generated by `coloc config`; the README's table documents each key.\n\n"
+         "fusion:\n";
+  for (const auto& p : fusion::ekfParams()) {
+    out << "  # " << p.meaning;
+    if (*p.unit) out << " [" << p.unit << "]";
+    out << "\n  " << p.key << ": " << fusion::formatValue(p, defaults.fusion) << "\n";
+  }
+  out << "\n# How log topics feed the filter. Topics not listed here are chosen by message type:\n"
+         "# PoseWithCovarianceStamped -> pose; TwistWithCovarianceStamped, Odometry, Imu -> twist;\n"
+         "# Odometry on a topic whose name contains \"ground_truth\" -> ground truth; others are listed and skipped.\n"
+         "# Example:\n"
+         "#   /amcl_pose: {role: pose, source: amcl}\n"
+         "#   /odom: {role: twist, covariance_diagonal: [0.01, .inf, .inf, .inf, .inf, 0.0025]}\n"
+         "#   /rsu/fix: {role: pose, additional_delay: 0.01}\n"
+         "inputs: {}\n\nreplay:\n";
+  for (const auto& k : replayKeys()) {
+    out << "  # " << k.meaning;
+    if (*k.unit) out << " [" << k.unit << "]";
+    out << "\n  " << k.key << ": " << k.value(defaults.replay) << "\n";
+  }
+  return out.str();
+}
+
+std::string configReferenceMarkdown() {
+  const FuseConfig defaults;
+  std::ostringstream out;
+  out << "| key | default | unit | meaning |\n|---|---|---|---|\n";
+  for (const auto& p : fusion::ekfParams())
+    out << "| `fusion." << p.key << "` | `" << fusion::formatValue(p, defaults.fusion) << "` | " << p.unit << " | "
+        << p.meaning << " |\n";
+  out << "| `inputs.TOPIC.role` | by type | | `pose`, `twist`, `ground_truth` or `ignore` |\n"
+         "| `inputs.TOPIC.source` | the topic | | the source's name in the filter and the summary |\n"
+         "| `inputs.TOPIC.covariance_diagonal` | from the message | variances | 6 values replacing the message's covariance; `.inf` = not measured |\n"
+         "| `inputs.TOPIC.additional_delay` | `0` | s | the data was sensed this long before its stamp |\n";
+  for (const auto& k : replayKeys())
+    out << "| `replay." << k.key << "` | `" << k.value(defaults.replay) << "` | " << k.unit << " | " << k.meaning << " |\n";
+  return out.str();
+}
+
+}  // namespace coloc::tools
