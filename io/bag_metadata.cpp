@@ -42,7 +42,8 @@ class MetadataParser {
     return required<std::int64_t>(node, inner, context + key + ".", "an integer");
   }
 
-  const YAML::Node& sequence(const YAML::Node& node, const std::string& key) const {
+  /// By value: YAML::Node is a handle, and the callers pass temporaries from operator[].
+  YAML::Node sequence(const YAML::Node& node, const std::string& key) const {
     if (!node.IsSequence()) fail("key '" + key + "' must be a list");
     return node;
   }
