@@ -184,9 +184,9 @@ void addFuseCommand(CLI::App& app) {
     std::error_code ec;
     fs::create_directories(out_dir, ec);
     if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    // The header names no file, so the same data in another storage format gives the same bytes.
     io::writeTumTrajectory(out_dir + "/fused.tum", result.fused,
-                           "coloc fused trajectory of " + fs::path(log).filename().string() +
-                               "\nt x y z qx qy qz qw (t: header-stamp clock, s)");
+                           "coloc fused trajectory\nt x y z qx qy qz qw (t: header-stamp clock, s)");
     std::ofstream(out_dir + "/summary.json") << summaryJson(log, result).dump(2) << "\n";
     nlohmann::ordered_json timing = {{"replay_wall_s", result.wall_seconds},
                                      {"speed_x_realtime", result.wall_seconds > 0 ? result.log_duration / result.wall_seconds : 0.0}};
