@@ -10,6 +10,7 @@ packages=(
   libfastcdr-dev libfastrtps-dev fastddsgen
   libsqlite3-dev libzstd-dev liblz4-dev libyaml-cpp-dev
   libcli11-dev nlohmann-json3-dev
+  libpcl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()

@@ -7,5 +7,6 @@ namespace coloc::tools {
 void addFuseCommand(CLI::App& app);
 void addConvertCommand(CLI::App& app);
 void addConfigCommand(CLI::App& app);
+void addAlignCommand(CLI::App& app);
 
 }  // namespace coloc::tools

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   coloc::tools::addFuseCommand(app);
   coloc::tools::addConvertCommand(app);
   coloc::tools::addConfigCommand(app);
+  coloc::tools::addAlignCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,133 @@
+// NDT cost, stock PCL against coloc's fast backend, measured side by side in one run:
+//  - the real HDL-32E pair, 0.1 m voxel source (~16k points), resolution 2.0, from identity;
+//  - Autoware-sized input (~1,000-1,500 points) from a 0.5 m / 2 deg initial offset;
+//  - building the target from the 487k-point airborne tile.
+// Ends with a table of medians, ratios and the pose agreement of the two backends.
+//
+//   build/bench/ndt_bench
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Geometry>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "coloc/ndt/aligner.hpp"
+#include "coloc/ndt/pcd_file.hpp"
+#include "coloc/ndt/preprocess.hpp"
+#include "real_data.hpp"
+
+namespace {
+
+using namespace coloc;
+using namespace coloc::ndt;
+
+struct Data {
+  PointCloud target, source_dense, source_autoware, als;
+  Eigen::Matrix4d gt1, offset_guess;
+};
+
+const Data& data() {
+  static const Data d = [] {
+    Data d;
+    d.target = loadPcd(testing::realData("hdl32e_pair/target.pcd"));
+    const PointCloud raw = loadPcd(testing::realData("hdl32e_pair/source.pcd"));
+    d.source_dense = voxelDownsample(raw, 0.1);
+    PreprocessConfig pre;
+    pre.voxel_size = 1.0;  // Autoware's 3 m leaves only ~240 points of this scan; 1 m gives ~1,000
+    d.source_autoware = preprocessScan(raw, pre);
+    d.als = loadPcd(testing::realData("als_tile/csite2_demeaned.pcd"));
+    d.gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
+    d.offset_guess = d.gt1;
+    d.offset_guess.topLeftCorner<3, 3>() = Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * d.gt1.topLeftCorner<3, 3>();
+    d.offset_guess.topRightCorner<3, 1>() += Eigen::Vector3d(0.4, -0.3, 0.0);
+    return d;
+  }();
+  return d;
+}
+
+NdtConfig configFor(NdtBackend backend) {
+  NdtConfig c;
+  c.backend = backend;
+  return c;
+}
+
+std::map<std::string, Eigen::Matrix4d> final_pose;  // last result per benchmark, for the agreement check
+
+void BM_AlignDense(benchmark::State& state) {
+  const NdtConfig config = configFor(static_cast<NdtBackend>(state.range(0)));
+  const NdtTarget target(data().target, config);
+  AlignResult r;
+  for (auto _ : state) r = align(target, data().source_dense, Eigen::Matrix4d::Identity(), config);
+  state.counters["iterations"] = r.iterations;
+  state.counters["points"] = static_cast<double>(data().source_dense.size());
+  final_pose[std::string("dense/") + std::to_string(state.range(0))] = r.transform;
+}
+
+void BM_AlignAutowareSized(benchmark::State& state) {
+  const NdtConfig config = configFor(static_cast<NdtBackend>(state.range(0)));
+  const NdtTarget target(data().target, config);
+  AlignResult r;
+  for (auto _ : state) r = align(target, data().source_autoware, data().offset_guess, config);
+  state.counters["iterations"] = r.iterations;
+  state.counters["points"] = static_cast<double>(data().source_autoware.size());
+  final_pose[std::string("autoware/") + std::to_string(state.range(0))] = r.transform;
+}
+
+void BM_BuildTargetAls(benchmark::State& state) {
+  const NdtConfig config = configFor(static_cast<NdtBackend>(state.range(0)));
+  std::size_t voxels = 0;
+  for (auto _ : state) voxels = NdtTarget(data().als, config).voxelCount();
+  state.counters["voxels"] = static_cast<double>(voxels);
+  state.counters["points"] = static_cast<double>(data().als.size());
+}
+
+void backends(benchmark::internal::Benchmark* b) {
+  b->Arg(static_cast<int>(NdtBackend::kPcl))->Arg(static_cast<int>(NdtBackend::kFast));
+  b->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true)->UseRealTime();
+}
+BENCHMARK(BM_AlignDense)->Apply(backends)->Iterations(3);
+BENCHMARK(BM_AlignAutowareSized)->Apply(backends)->Iterations(20);
+BENCHMARK(BM_BuildTargetAls)->Apply(backends)->Iterations(2);
+
+class MedianCollector : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs)
+      if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "median")
+        medians[run.run_name.function_name][run.run_name.args] = run.GetAdjustedRealTime();
+  }
+  std::map<std::string, std::map<std::string, double>> medians;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  MedianCollector reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const std::string pcl = std::to_string(static_cast<int>(NdtBackend::kPcl));
+  const std::string fast = std::to_string(static_cast<int>(NdtBackend::kFast));
+  std::printf("\nMedian milliseconds, stock pcl::NormalDistributionsTransform vs coloc fast backend (resolution 2.0)\n");
+  std::printf("%-44s %10s %10s %8s\n", "case", "pcl", "fast", "ratio");
+  const std::pair<const char*, const char*> cases[] = {
+      {"BM_AlignDense", "HDL-32E pair, 0.1 m voxel source, identity"},
+      {"BM_AlignAutowareSized", "HDL-32E, 1 m voxel source, 0.5 m / 2 deg off"},
+      {"BM_BuildTargetAls", "target build, ALS tile (487k points)"}};
+  for (const auto& [name, label] : cases) {
+    auto& m = reporter.medians[name];
+    if (!m.count(pcl) || !m.count(fast)) continue;
+    std::printf("%-44s %10.2f %10.2f %7.1fx\n", label, m[pcl], m[fast], m[pcl] / m[fast]);
+  }
+  for (const char* which : {"dense", "autoware"}) {
+    const auto a = final_pose.find(std::string(which) + "/" + pcl), b = final_pose.find(std::string(which) + "/" + fast);
+    if (a == final_pose.end() || b == final_pose.end()) continue;
+    const auto [m, deg] = testing::poseDifference(a->second, b->second);
+    const auto [m_gt, deg_gt] = testing::poseDifference(b->second, data().gt1);
+    std::printf("%-9s fast vs pcl: %.2f cm, %.3f deg; fast vs GT1: %.2f cm, %.3f deg\n", which, 100 * m, deg, 100 * m_gt, deg_gt);
+  }
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,38 @@
+#pragma once
+// NdtTarget's insides; PCL appears only here and in the .cpp files of ndt/.
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/registration/ndt.h>
+
+#include <memory>
+
+#include "coloc/ndt/ndt_target.hpp"
+#include "ndt_score.hpp"
+#include "voxel_lookup.hpp"
+
+namespace coloc::ndt {
+
+using PclPoint = pcl::PointXYZ;
+using PclCloud = pcl::PointCloud<PclPoint>;
+
+/// PCL's NDT with its voxel grid made readable, so that scores and the direct lookup are built from the
+/// very voxels PCL aligns against.
+class ExposedNdt : public pcl::NormalDistributionsTransform<PclPoint, PclPoint> {
+ public:
+  const TargetGrid& grid() const { return target_cells_; }
+};
+
+struct NdtTarget::Impl {
+  NdtConfig config;
+  ScoreConstants constants;
+  PclCloud::Ptr cloud;
+  /// The stock backend aligns with this object; its voxel grid also feeds `voxels`.
+  std::shared_ptr<ExposedNdt> pcl_ndt;
+  /// The fast backend's grid (no k-d tree: it is never searched by radius).
+  std::shared_ptr<pcl::VoxelGridCovariance<PclPoint>> grid;
+  VoxelLookup voxels;
+};
+
+PclCloud::Ptr toPcl(const PointCloud& cloud);
+
+}  // namespace coloc::ndt

@@ -1,0 +1,60 @@
+#pragma once
+// Direct lookup of NDT voxels by integer voxel coordinates: an open-addressing hash over the usable
+// leaves of a pcl::VoxelGridCovariance, with each voxel's mean and inverse covariance stored
+// contiguously. Replaces the k-d tree radius search PCL's NDT does for every point and iteration.
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace coloc::ndt {
+
+struct Voxel {
+  Eigen::Vector3d mean;
+  Eigen::Matrix3d inverse_covariance;
+};
+
+class VoxelLookup {
+ public:
+  void reserve(std::size_t voxels);
+  void insert(const Eigen::Vector3i& coordinates, const Voxel& voxel);
+  /// Call after the last insert.
+  void finish();
+
+  const Voxel* find(const Eigen::Vector3i& coordinates) const {
+    if (slots_.empty()) return nullptr;
+    const std::uint64_t key = pack(coordinates);
+    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
+      const Slot& s = slots_[i];
+      if (s.voxel < 0) return nullptr;
+      if (s.key == key) return &voxels_[static_cast<std::size_t>(s.voxel)];
+    }
+  }
+
+  std::size_t size() const { return voxels_.size(); }
+  const std::vector<Voxel>& voxels() const { return voxels_; }
+
+ private:
+  struct Slot {
+    std::uint64_t key = 0;
+    std::int64_t voxel = -1;
+  };
+  static std::uint64_t pack(const Eigen::Vector3i& c) {
+    // 21 bits per axis with an offset: +-1e6 voxels, i.e. +-2000 km at 2 m resolution.
+    constexpr std::int64_t kOffset = 1 << 20;
+    return (static_cast<std::uint64_t>(c.x() + kOffset) << 42) | (static_cast<std::uint64_t>(c.y() + kOffset) << 21) |
+           static_cast<std::uint64_t>(c.z() + kOffset);
+  }
+  static std::uint64_t hash(std::uint64_t key) {
+    key ^= key >> 33;
+    key *= 0xff51afd7ed558ccdULL;
+    key ^= key >> 33;
+    return key;
+  }
+
+  std::vector<Voxel> voxels_;
+  std::vector<Eigen::Vector3i> coordinates_;
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0;
+};
+
+}  // namespace coloc::ndt

@@ -1,0 +1,69 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "coloc/ndt/preprocess.hpp"
+
+namespace coloc::ndt {
+namespace {
+
+TEST(Preprocess, VoxelDownsampleKeepsOneCentroidPerVoxel) {
+  PointCloud cloud;
+  cloud.points = {{0.1f, 0.1f, 0.1f}, {0.3f, 0.5f, 0.1f}, {1.5f, 0.2f, 0.2f}, {-0.5f, 0.0f, 0.0f}};
+  const PointCloud out = voxelDownsample(cloud, 1.0);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_TRUE(out.points[0].isApprox(Eigen::Vector3f(0.2f, 0.3f, 0.1f)));  // first two share a voxel
+  EXPECT_TRUE(out.points[1].isApprox(Eigen::Vector3f(1.5f, 0.2f, 0.2f)));
+  EXPECT_TRUE(out.points[2].isApprox(Eigen::Vector3f(-0.5f, 0.0f, 0.0f)));  // negative side is its own voxel
+}
+
+TEST(Preprocess, CapTakesARepeatableSubsetOfTheRequestedSize) {
+  PointCloud cloud;
+  for (int i = 0; i < 5000; ++i) cloud.points.emplace_back(static_cast<float>(i), 0.0f, 0.0f);
+  const PointCloud a = capPoints(cloud, 1500, 7), b = capPoints(cloud, 1500, 7), c = capPoints(cloud, 1500, 8);
+  EXPECT_EQ(a.size(), 1500u);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_NE(a.points, c.points);
+  // Spread over the whole cloud, not its first points.
+  EXPECT_GT(a.points.back().x(), 4500.0f);
+  EXPECT_EQ(capPoints(cloud, 0, 1).size(), 5000u);
+}
+
+TEST(Preprocess, CropKeepsTheRangeBand) {
+  PointCloud cloud;
+  cloud.points = {{0.5f, 0, 0}, {5, 0, 0}, {0, 59, 0}, {70, 0, 0}};
+  const PointCloud out = cropRange(cloud, 1.0, 60.0);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out.points[1].y(), 59.0f);
+}
+
+TEST(Preprocess, DeskewUndoesTheMotionDuringTheSweep) {
+  // A wall at x = 10 seen while driving at 10 m/s and turning at 0.5 rad/s: a point sampled at time t
+  // is seen from where the sensor was then. Deskewing must put every point back on the wall.
+  const double vx = 10.0, wz = 0.5;
+  PointCloud scan;
+  for (int i = 0; i <= 100; ++i) {
+    const double t = 0.001 * i;  // 0..0.1 s
+    const Eigen::Vector2d wall(10.0, -5.0 + 0.1 * i);
+    const double yaw = wz * t;
+    const Eigen::Vector2d sensor(vx * std::sin(yaw) / wz, vx * (1 - std::cos(yaw)) / wz);
+    const Eigen::Vector2d d = wall - sensor;
+    const Eigen::Vector2d local(std::cos(yaw) * d.x() + std::sin(yaw) * d.y(), -std::sin(yaw) * d.x() + std::cos(yaw) * d.y());
+    scan.points.emplace_back(static_cast<float>(local.x()), static_cast<float>(local.y()), 0.0f);
+    scan.times.push_back(static_cast<float>(t));
+  }
+  double skewed = 0.0;
+  for (const auto& p : scan.points) skewed = std::max(skewed, std::abs(p.x() - 10.0));
+  EXPECT_GT(skewed, 0.5);  // the raw scan is visibly bent
+  const PointCloud fixed = deskew(scan, vx, wz);
+  for (const auto& p : fixed.points) EXPECT_NEAR(p.x(), 10.0, 1e-4);
+}
+
+TEST(Preprocess, DeskewWithoutTimesLeavesTheScanAlone) {
+  PointCloud cloud;
+  cloud.points = {{1, 2, 3}};
+  EXPECT_EQ(deskew(cloud, 10.0, 1.0).points, cloud.points);
+}
+
+}  // namespace
+}  // namespace coloc::ndt
