@@ -322,10 +322,24 @@ struct Localizer::Impl {
     return Verdict{Outcome::kApplied, Reason::kNone, InputKind::kClock, "", now, -1, 0.0, {}};
   }
 
-  Estimate estimate() {
-    const FilterState& s = history.latest();
+  Estimate estimate() { return describe(history.latest(), history.latestStamp()); }
+
+  // The state at a past tick, or predicted ahead (without changing the filter) for a later stamp.
+  std::optional<Estimate> estimateAt(Stamp stamp) {
+    if (const auto back = history.ticksBack(stamp)) return describe(history.stateAt(*back), history.stampAt(*back));
+    if (stamp < history.latestStamp()) return std::nullopt;  // older than the history
+    FilterState s = history.latest();
+    const double dt = toSeconds(stamp - history.latestStamp());
+    const Matrix6d A = motionJacobian(s.x, dt);
+    s.x = predictState(s.x, dt);
+    s.P = propagateCovariance(A, s.P, processNoise(history.options().noise, dt));
+    predictAux(s, history.options().aux_proc_dev, dt);
+    return describe(s, stamp);
+  }
+
+  Estimate describe(const FilterState& s, Stamp stamp) const {
     Estimate e;
-    e.stamp = history.latestStamp();
+    e.stamp = stamp;
     e.state = s.x;
     e.state_covariance = s.P;
     e.yaw_bias = s.x[kYawBias];
@@ -401,6 +415,11 @@ Verdict Localizer::advanceTo(Stamp now) { return impl_->advanceTo(now); }
 std::optional<Estimate> Localizer::estimate() {
   if (!impl_->initialized) return std::nullopt;
   return impl_->estimate();
+}
+
+std::optional<Estimate> Localizer::estimateAt(Stamp stamp) {
+  if (!impl_->initialized) return std::nullopt;
+  return impl_->estimateAt(stamp);
 }
 
 void Localizer::setVerdictListener(std::function<void(const Verdict&)> listener) { impl_->listener = std::move(listener); }

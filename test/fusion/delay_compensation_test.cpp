@@ -150,3 +150,34 @@ TEST(DelayCompensation, DelayedFixStillImprovesTheCurrentEstimate) {
 
 }  // namespace
 }  // namespace coloc::fusion
+
+namespace coloc::fusion {
+namespace {
+
+using namespace coloc::testing;
+
+TEST(EstimateAt, PastStampGivesThatTicksStateAndLaterStampAPredictionWithoutChangingTheFilter) {
+  const Drive drive;
+  EkfConfig config = quietConfig();
+  config.twist_smoothing_steps = 1;  // so that nothing fed after tick 20 lands on tick 20
+  Localizer localizer = startedLocalizer(config);
+  Vector6d at_20 = Vector6d::Zero();
+  for (int k = 1; k <= 30; ++k) {
+    driveTick(localizer, drive, k);
+    if (k == 20) at_20 = localizer.estimate()->state;
+  }
+  const Snapshot before = snapshot(localizer);
+  EXPECT_TRUE(localizer.estimateAt(kStart + 20 * kTick + 3'000'000)->state.isApprox(at_20, 1e-12));
+  // 50 ms past the newest tick: the motion model carried forward from there.
+  const Estimate now = *localizer.estimate();
+  const Estimate ahead = *localizer.estimateAt(now.stamp + 50'000'000);
+  const double heading = now.state[2] + now.state[3];
+  EXPECT_NEAR(ahead.state[0], now.state[0] + now.state[4] * 0.05 * std::cos(heading), 1e-9);
+  EXPECT_NEAR(ahead.state[1], now.state[1] + now.state[4] * 0.05 * std::sin(heading), 1e-9);
+  EXPECT_GT(ahead.state_covariance(0, 0), now.state_covariance(0, 0));
+  EXPECT_FALSE(localizer.estimateAt(kStart - kNanosPerSecond).has_value());
+  EXPECT_TRUE(snapshot(localizer) == before);
+}
+
+}  // namespace
+}  // namespace coloc::fusion

@@ -69,6 +69,11 @@ class Localizer {
   /// The estimate at the newest tick; nullopt before initialisation.
   std::optional<Estimate> estimate();
 
+  /// The estimate at the tick nearest `stamp` (what a scan matcher needs as its initial guess for a
+  /// scan taken then), or predicted forward from the newest tick for a later stamp, leaving the filter
+  /// unchanged. nullopt before initialisation or for a stamp older than the history.
+  std::optional<Estimate> estimateAt(Stamp stamp);
+
   /// Verdicts decided later than the call that fed them (pending measurements) reach this listener;
   /// every verdict returned from a call also does.
   void setVerdictListener(std::function<void(const Verdict&)> listener);
