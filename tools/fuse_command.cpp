@@ -83,6 +83,18 @@ nlohmann::ordered_json summaryJson(const std::string& log, const ReplayResult& r
   } else {
     j["position_error"] = nullptr;
   }
+  if (r.ndt_used) {
+    j["ndt"] = {{"scans", r.ndt.scans},
+                {"poses", r.ndt.poses},
+                {"scans_without_guess", r.scans_without_guess},
+                {"no_map", r.ndt.no_map},
+                {"empty_scan", r.ndt.empty_scan},
+                {"max_iterations", r.ndt.max_iterations},
+                {"oscillation", r.ndt.oscillation},
+                {"low_score", r.ndt.low_score},
+                {"map_builds", r.map.builds},
+                {"tiles_in_target", r.map.tiles_in_target}};
+  }
   j["rejections_first"] = r.rejections;
   return j;
 }
@@ -115,6 +127,15 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
   }
   for (const TopicUse& t : r.topics)
     if (!t.first_error.empty()) std::printf("  first decode error: %s\n", t.first_error.c_str());
+  if (r.ndt_used) {
+    const auto& n = r.ndt;
+    std::printf("\n  NDT: %llu scans -> %llu poses; rejected: %llu low score, %llu iteration limit, %llu oscillation, %llu empty, "
+                "%llu off the map; %llu before the filter could predict; mean alignment %.1f ms; map rebuilt %zu times\n",
+                (unsigned long long)n.scans, (unsigned long long)n.poses, (unsigned long long)n.low_score,
+                (unsigned long long)n.max_iterations, (unsigned long long)n.oscillation, (unsigned long long)n.empty_scan,
+                (unsigned long long)n.no_map, (unsigned long long)r.scans_without_guess, n.scans ? n.align_ms_total / n.scans : 0.0,
+                r.map.builds);
+  }
   if (!r.errors.empty()) {
     const ErrorStats s = errorStats(r.errors);
     std::printf("\n  position error vs ground truth (%zu ticks): mean %.4f m, RMSE %.4f m, max %.4f m\n", r.errors.size(), s.mean,
@@ -170,13 +191,15 @@ void writeErrorCsv(const ReplayResult& r, const std::string& path) {
 
 void addFuseCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("fuse", "Fuse a recorded ROS 2 log (.mcap, .db3 or rosbag2 folder) and write the trajectory");
-  static std::string log, config_path, out_dir = "coloc_out";
+  static std::string log, config_path, map, out_dir = "coloc_out";
   cmd->add_option("LOG", log, "the recording")->required();
   cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`)")->check(CLI::ExistingFile);
+  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles): PointCloud2 topics then feed NDT");
   cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
   cmd->callback([] {
     ReplayOptions options;
     if (!config_path.empty()) options.config = loadFuseConfig(config_path);
+    options.map = map;
     ProgressBar progress("fusing");
     options.progress = [&](double f) { progress.update(f); };
     const ReplayResult result = replayLog(log, options);

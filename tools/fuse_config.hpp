@@ -9,10 +9,11 @@
 
 #include "coloc/core/types.hpp"
 #include "coloc/fusion/ekf_config.hpp"
+#include "coloc/ndt/ndt_pose_source.hpp"
 
 namespace coloc::tools {
 
-enum class InputRole { kPose, kTwist, kGroundTruth, kIgnore };
+enum class InputRole { kPose, kTwist, kGroundTruth, kScan, kIgnore };
 const char* toString(InputRole role);
 
 /// How one topic is used. Topics not listed are chosen by message type (see README).
@@ -37,10 +38,20 @@ struct ReplayConfig {
   Vector6d fallback_twist_variance = (Vector6d() << 0.04, kInfinity, kInfinity, kInfinity, kInfinity, 0.01).finished();
   /// Ground truth further than this from an output tick is not interpolated across.
   double ground_truth_max_gap = 0.2;  ///< s
+  /// Starts the filter here (x, y, z [m], yaw [rad]) at the first message, for logs whose only pose
+  /// source is NDT, which needs a first guess.
+  std::optional<Eigen::Vector4d> initial_pose;
+};
+
+/// Scan matching of the log's PointCloud2 topic against a map (`coloc fuse --map`).
+struct NdtSection {
+  ndt::NdtPoseSourceConfig source;
+  double map_tile_size = 20.0;  ///< m; a single-file map is cut into squares of this size
 };
 
 struct FuseConfig {
   fusion::EkfConfig fusion;
+  NdtSection ndt;
   std::map<std::string, InputConfig> inputs;  ///< by topic
   ReplayConfig replay;
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <set>
 #include <variant>
@@ -9,6 +10,7 @@
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_reader.hpp"
 #include "coloc/io/ros_messages.hpp"
+#include "point_cloud2_convert.hpp"
 
 namespace coloc::tools {
 
@@ -23,11 +25,13 @@ struct Event {
   Stamp arrival;  ///< log_time on the stamp clock
   std::uint64_t order;
   std::size_t topic;
-  std::variant<PoseMeasurement, TwistMeasurement> measurement;
+  std::variant<PoseMeasurement, TwistMeasurement, ndt::PointCloud> measurement;
 };
 
 bool canServe(InputRole role, MessageKind kind) {
   switch (role) {
+    case InputRole::kScan:
+      return kind == MessageKind::kPointCloud2;
     case InputRole::kPose:
     case InputRole::kGroundTruth:
       return kind == MessageKind::kPoseWithCovarianceStamped || kind == MessageKind::kPoseStamped ||
@@ -42,7 +46,7 @@ bool canServe(InputRole role, MessageKind kind) {
 }
 
 // The role a topic gets when the config does not name it.
-InputRole defaultRole(const std::string& topic, MessageKind kind, std::string& note) {
+InputRole defaultRole(const std::string& topic, MessageKind kind, bool have_map, std::string& note) {
   const bool truth_name = topic.find("ground_truth") != std::string::npos || topic.find("groundtruth") != std::string::npos;
   switch (kind) {
     case MessageKind::kPoseWithCovarianceStamped: return truth_name ? InputRole::kGroundTruth : InputRole::kPose;
@@ -57,7 +61,8 @@ InputRole defaultRole(const std::string& topic, MessageKind kind, std::string& n
       note = "TwistStamped carries no covariance: give it a role in the config to use it";
       return InputRole::kIgnore;
     case MessageKind::kPointCloud2:
-      note = "point clouds feed NDT, which needs a map";
+      if (have_map) return InputRole::kScan;
+      note = "point clouds feed NDT, which needs a map (--map)";
       return InputRole::kIgnore;
   }
   return InputRole::kIgnore;
@@ -115,6 +120,22 @@ std::optional<Eigen::Vector2d> truthAt(const std::vector<io::TrajectoryPoint>& t
   return ((1.0 - w) * before->pose.position.head<2>() + w * after->pose.position.head<2>()).eval();
 }
 
+ndt::NdtPoseSourceConfig ndtSourceConfig(const FuseConfig& config) {
+  ndt::NdtPoseSourceConfig c = config.ndt.source;
+  c.map.background = false;  // offline: the same log gives the same bytes, whatever the machine's speed
+  return c;
+}
+
+PoseMeasurement initialPose(const Eigen::Vector4d& xyz_yaw, Stamp stamp) {
+  PoseMeasurement m;
+  m.stamp = stamp;
+  m.pose.position = xyz_yaw.head<3>();
+  m.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, xyz_yaw[3]);
+  m.covariance = Matrix6d::Zero();
+  m.covariance.diagonal() << 1.0, 1.0, 1.0, kInfinity, kInfinity, 0.01;  // a rough start, as a hand-placed pose
+  return m;
+}
+
 }  // namespace
 
 ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options) {
@@ -142,8 +163,8 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     } else if (!kind) {
       use.note = "type not decoded by coloc";
     } else {
-      use.role = defaultRole(t.name, *kind, use.note);
-      use.source = t.name;
+      use.role = defaultRole(t.name, *kind, !options.map.empty(), use.note);
+      use.source = use.role == InputRole::kScan ? "ndt" : t.name;
     }
     if (use.role != InputRole::kIgnore && t.serialization_format != "cdr") {
       use.note = "serialization format '" + t.serialization_format + "' is not CDR";
@@ -177,7 +198,13 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     try {
       const io::RosMessage decoded = io::decodeMessage(*kinds[ti], message.data);
       bool fallback = false;
-      std::variant<PoseMeasurement, TwistMeasurement> m;
+      std::variant<PoseMeasurement, TwistMeasurement, ndt::PointCloud> m;
+      if (use.role == InputRole::kScan) {
+        if (options.map.empty()) throw Error("a scan topic needs a map (--map)");
+        const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
+        events.push_back({message.log_time, cloud.header.stamp, 0, message.index, ti, toPointCloud(cloud)});
+        continue;
+      }
       if (use.role == InputRole::kTwist) {
         TwistMeasurement t;
         if (const auto* odom = std::get_if<io::Odometry>(&decoded)) t = odom->twist;
@@ -196,10 +223,11 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
         m = p;
       }
       if (fallback) ++use.fallback_covariance;
-      Stamp stamp = std::visit([](const auto& x) { return x.stamp; }, m);
+      Stamp stamp = std::holds_alternative<PoseMeasurement>(m) ? std::get<PoseMeasurement>(m).stamp : std::get<TwistMeasurement>(m).stamp;
       if (input && input->additional_delay > 0.0) {
         stamp -= fromSeconds(input->additional_delay);
-        std::visit([stamp](auto& x) { x.stamp = stamp; }, m);
+        if (auto* pose = std::get_if<PoseMeasurement>(&m)) pose->stamp = stamp;
+        if (auto* twist = std::get_if<TwistMeasurement>(&m)) twist->stamp = stamp;
       }
       events.push_back({message.log_time, stamp, 0, message.index, ti, std::move(m)});
     } catch (const Error& e) {
@@ -239,8 +267,14 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   // 4. Replay through the filter, recording the estimate at every tick.
   fusion::Localizer localizer(config.fusion);
   std::vector<fusion::SourceId> source_of(result.topics.size(), -1);
+  std::unique_ptr<ndt::NdtPoseSource> ndt_source;
   for (std::size_t i = 0; i < result.topics.size(); ++i) {
-    if (result.topics[i].role == InputRole::kPose) source_of[i] = localizer.addPoseSource(result.topics[i].source);
+    if (result.topics[i].role == InputRole::kScan && !ndt_source) {
+      ndt_source = std::make_unique<ndt::NdtPoseSource>(ndt::TileMap::open(options.map, config.ndt.map_tile_size), ndtSourceConfig(config));
+      result.ndt_used = true;
+    }
+    if (result.topics[i].role == InputRole::kPose || result.topics[i].role == InputRole::kScan)
+      source_of[i] = localizer.addPoseSource(result.topics[i].source);
     if (result.topics[i].role == InputRole::kTwist) source_of[i] = localizer.addTwistSource(result.topics[i].source);
   }
   localizer.setVerdictListener([&](const fusion::Verdict& v) {
@@ -262,8 +296,27 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   };
   for (std::size_t i = 0; i < events.size(); ++i) {
     const Event& e = events[i];
-    if (options.progress && i % 256 == 0) options.progress(0.5 + 0.5 * i / events.size());
+    if (options.progress && (i % 256 == 0 || std::holds_alternative<ndt::PointCloud>(e.measurement)))
+      options.progress(0.5 + 0.5 * i / events.size());
+    if (i == 0 && config.replay.initial_pose) localizer.initialize(initialPose(*config.replay.initial_pose, e.stamp));
     runTo(e.arrival);
+    if (const auto* scan = std::get_if<ndt::PointCloud>(&e.measurement)) {
+      // NDT starts from the filter's prediction for the scan's stamp, and its pose goes back in as a
+      // measurement stamped with the scan: the filter compensates the matching time as any delay.
+      const std::optional<fusion::Estimate> guess = localizer.estimateAt(e.stamp);
+      if (!guess) {
+        ++result.scans_without_guess;
+        continue;
+      }
+      const ndt::ScanOutcome outcome = ndt_source->process(*scan, e.stamp, guess->pose, guess->state[4], guess->state[5]);
+      if (outcome.produced) {
+        result.pose_inputs.push_back({outcome.pose.stamp, outcome.pose.pose});
+        localizer.feedPose(source_of[e.topic], outcome.pose);
+      } else if (result.rejections.size() < 20) {
+        result.rejections.push_back("scan stamped " + formatSeconds(e.stamp) + ": " + outcome.detail);
+      }
+      continue;
+    }
     if (const auto* p = std::get_if<PoseMeasurement>(&e.measurement)) {
       result.pose_inputs.push_back({p->stamp, p->pose});
       const bool was_initialized = localizer.initialized();
@@ -277,6 +330,10 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     }
   }
   if (options.progress) options.progress(1.0);
+  if (ndt_source) {
+    result.ndt = ndt_source->counters();
+    result.map = ndt_source->map().stats();
+  }
   result.sources = localizer.sources();
   result.unknown_source_inputs = localizer.unknownSourceCount();
   if (!result.fused.empty()) {

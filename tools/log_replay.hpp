@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "coloc/fusion/localizer.hpp"
+#include "coloc/ndt/ndt_pose_source.hpp"
 #include "coloc/io/trajectory_file.hpp"
 #include "clock_fit.hpp"
 #include "fuse_config.hpp"
@@ -52,10 +53,15 @@ struct ReplayResult {
   double wall_seconds = 0.0;                       ///< replay time, decoding included
   std::uint64_t messages_read = 0;
   std::vector<std::string> rejections;             ///< the first few rejection messages, for the summary
+  bool ndt_used = false;
+  ndt::NdtPoseSourceCounters ndt;                  ///< scan matching, when a map was given
+  std::uint64_t scans_without_guess = 0;           ///< scans before the filter could predict their pose
+  ndt::DynamicMapStats map;
 };
 
 struct ReplayOptions {
   FuseConfig config;
+  std::string map;  ///< PCD file or folder of tiles; with it, PointCloud2 topics feed NDT
   std::function<void(double fraction)> progress;  ///< called now and then with 0..1
 };
 

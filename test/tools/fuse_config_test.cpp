@@ -63,6 +63,17 @@ TEST(FuseConfig, ReadsInputsWithTheirRolesAndOverrides) {
   EXPECT_EQ(c.fusion.pose_smoothing_steps, 3);
 }
 
+TEST(FuseConfig, ReadsTheNdtSection) {
+  const FuseConfig c = parseFuseConfig("ndt:\n  backend: pcl\n  resolution: 1.0\n  max_points: 2000\n  covariance: laplace\n"
+                                       "  lidar_pose: [1.0, 0, 1.8, 0, 0, 0.1]\n",
+                                       "test.yaml");
+  EXPECT_EQ(c.ndt.source.ndt.backend, ndt::NdtBackend::kPcl);
+  EXPECT_EQ(c.ndt.source.ndt.resolution, 1.0);
+  EXPECT_EQ(c.ndt.source.preprocess.max_points, 2000u);
+  EXPECT_EQ(c.ndt.source.ndt.covariance, ndt::CovarianceMode::kLaplace);
+  EXPECT_EQ(c.ndt.source.lidar_pose[2], 1.8);
+}
+
 TEST(FuseConfig, UnknownKeysAreErrorsNamingKeyAndLine) {
   expectError("fusion:\n  history_step: 50\n", "test.yaml:2: fusion.history_step: unknown key");
   expectError("fusoin: {}\n", "fusoin: unknown section");
@@ -75,8 +86,13 @@ TEST(FuseConfig, WrongTypesAndRangesAreErrorsNamingTheKey) {
   expectError("fusion:\n  history_steps: 2.5\n", "fusion.history_steps: expected an integer");
   expectError("fusion:\n  predict_frequency: -1\n", "predict_frequency");
   expectError("fusion:\n  pose_gate_alpha: .nan\n", "must not be NaN");
-  expectError("inputs:\n  /odom: {role: velocity}\n", "expected pose, twist, ground_truth or ignore");
+  expectError("inputs:\n  /odom: {role: velocity}\n", "expected pose, twist, ground_truth, scan or ignore");
   expectError("inputs:\n  /odom: {source: x}\n", "needs a role");
+  expectError("ndt:\n  backend: gpu\n", "ndt.backend: expected one of pcl, fast, got 'gpu'");
+  expectError("ndt:\n  resolution: 0\n", "ndt.resolution: must be a finite number > 0");
+  expectError("ndt:\n  lidar_pose: [0, 0, 1]\n", "ndt.lidar_pose: expected 6 numbers");
+  expectError("ndt:\n  voxel_sise: 1.0\n", "ndt.voxel_sise: unknown key");
+  expectError("replay:\n  initial_pose: [1, 2]\n", "replay.initial_pose: expected [x, y, z, yaw]");
   expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, 2]}\n", "expected 6 variances");
   expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, -2, 1, 1, 1, 1]}\n", "must be > 0");
   expectError("replay:\n  clock: sometimes\n", "expected auto, same or separate");

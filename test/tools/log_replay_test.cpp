@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <random>
 
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
+#include "coloc/ndt/pcd_file.hpp"
 #include "log_replay.hpp"
 #include "temp_dir.hpp"
 
@@ -156,6 +159,77 @@ TEST(LogReplay, ConfiguredRoleOnAnIncompatibleTypeIsAnErrorNamingTheTopic) {
 
 TEST(LogReplay, MissingLogIsAnErrorNamingIt) {
   EXPECT_THROW(replayLog("/nonexistent/log.mcap", {}), Error);
+}
+
+}  // namespace
+}  // namespace coloc::tools
+
+namespace coloc::tools {
+namespace {
+
+io::PointCloud2 toMessage(const ndt::PointCloud& cloud, Stamp stamp) {
+  io::PointCloud2 m;
+  m.header = {stamp, "lidar"};
+  m.height = 1;
+  m.width = static_cast<std::uint32_t>(cloud.size());
+  m.fields = {{"x", 0, io::PointField::kFloat32, 1}, {"y", 4, io::PointField::kFloat32, 1}, {"z", 8, io::PointField::kFloat32, 1}};
+  m.point_step = 12;
+  m.row_step = 12 * m.width;
+  m.is_dense = true;
+  m.data.resize(m.row_step);
+  std::memcpy(m.data.data(), cloud.points.data(), m.data.size());
+  return m;
+}
+
+TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
+  // The real HDL-32E pair: the target scan is the map, the source scan is in the log.
+  testing::TempDir dir;
+  const std::string map = COLOC_SHARED_DATA_DIR "/hdl32e_pair/target.pcd";
+  const ndt::PointCloud scan = ndt::loadPcd(COLOC_SHARED_DATA_DIR "/hdl32e_pair/source.pcd");
+  const Stamp t0 = 1'700'000'000'000'000'000LL;
+  {
+    io::BagWriter bag = io::BagWriter::create(dir / "scans");
+    bag.addTopic({"/points", "sensor_msgs/msg/PointCloud2"});
+    for (int i = 0; i < 3; ++i) {  // the same scan three times, 0.1 s apart, as a standing vehicle would see it
+      const io::Bytes b = io::encodePointCloud2(toMessage(scan, t0 + i * 100'000'000LL));
+      bag.write("/points", t0 + i * 100'000'000LL + 30'000'000LL, b.data(), b.size());
+    }
+    bag.close();
+  }
+  ReplayOptions options;
+  options.map = map;
+  options.config = parseFuseConfig("replay:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
+  const ReplayResult r = replayLog(dir / "scans", options);
+  EXPECT_TRUE(r.ndt_used);
+  EXPECT_EQ(topic(r, "/points").role, InputRole::kScan);
+  EXPECT_EQ(r.ndt.scans, 3u);
+  EXPECT_EQ(r.ndt.poses, 3u);
+  const Eigen::Matrix4d gt1 = [] {
+    std::ifstream in(COLOC_SHARED_DATA_DIR "/hdl32e_pair/T_target_source.gt1.txt");
+    Eigen::Matrix4d m;
+    for (int i = 0; i < 16; ++i) in >> m(i / 4, i % 4);
+    return m;
+  }();
+  ASSERT_FALSE(r.pose_inputs.empty());
+  EXPECT_NEAR(r.pose_inputs.back().pose.position.x(), gt1(0, 3), 0.03);
+  EXPECT_NEAR(r.pose_inputs.back().pose.position.y(), gt1(1, 3), 0.03);
+  EXPECT_GE(counters(r, "ndt").applied, 3u);
+}
+
+TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {
+  testing::TempDir dir;
+  {
+    io::BagWriter bag = io::BagWriter::create(dir / "scans");
+    bag.addTopic({"/points", "sensor_msgs/msg/PointCloud2"});
+    ndt::PointCloud cloud;
+    cloud.points = {{1, 2, 3}};
+    const io::Bytes b = io::encodePointCloud2(toMessage(cloud, 1'000'000'000));
+    bag.write("/points", 1'000'000'000, b.data(), b.size());
+    bag.close();
+  }
+  const ReplayResult r = replayLog(dir / "scans", {});
+  EXPECT_EQ(topic(r, "/points").role, InputRole::kIgnore);
+  EXPECT_NE(topic(r, "/points").note.find("--map"), std::string::npos);
 }
 
 }  // namespace

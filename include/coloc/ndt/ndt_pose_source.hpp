@@ -1,0 +1,59 @@
+#pragma once
+// NDT as a pose source for the filter, without ROS: a scan and the filter's prediction for its stamp
+// in, a vehicle pose with covariance (or the reason there is none) out.
+#include <cstdint>
+#include <string>
+
+#include "coloc/core/types.hpp"
+#include "coloc/ndt/aligner.hpp"
+#include "coloc/ndt/preprocess.hpp"
+#include "coloc/ndt/tile_map.hpp"
+
+namespace coloc::ndt {
+
+struct NdtPoseSourceConfig {
+  NdtConfig ndt;
+  PreprocessConfig preprocess;
+  MapUpdateConfig map;
+  /// The LiDAR's pose on the vehicle (base frame): x, y, z [m], roll, pitch, yaw [rad].
+  Vector6d lidar_pose = Vector6d::Zero();
+};
+
+struct NdtPoseSourceCounters {
+  std::uint64_t scans = 0;
+  std::uint64_t poses = 0;            ///< accepted results handed on
+  std::uint64_t no_map = 0;           ///< no tile near the predicted position
+  std::uint64_t empty_scan = 0;       ///< nothing left after preprocessing
+  std::uint64_t max_iterations = 0;
+  std::uint64_t oscillation = 0;
+  std::uint64_t low_score = 0;
+  double align_ms_total = 0.0;
+};
+
+struct ScanOutcome {
+  bool produced = false;
+  PoseMeasurement pose;  ///< the vehicle (base frame) in the map, stamped with the scan's stamp
+  AlignResult alignment;
+  std::size_t points_used = 0;
+  std::string detail;    ///< why nothing was produced
+};
+
+class NdtPoseSource {
+ public:
+  NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config);
+
+  /// `scan` in the LiDAR frame, `predicted` the vehicle pose the filter predicts for `stamp`, `vx` and
+  /// `wz` its twist (for deskewing). Never throws for bad scans: the outcome says what happened.
+  ScanOutcome process(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
+
+  const NdtPoseSourceCounters& counters() const { return counters_; }
+  const DynamicMap& map() const { return map_; }
+
+ private:
+  NdtPoseSourceConfig config_;
+  DynamicMap map_;
+  Eigen::Matrix4d base_to_lidar_;
+  NdtPoseSourceCounters counters_;
+};
+
+}  // namespace coloc::ndt

@@ -1,0 +1,69 @@
+#include "coloc/ndt/ndt_pose_source.hpp"
+
+#include <Eigen/Geometry>
+
+namespace coloc::ndt {
+
+namespace {
+
+Eigen::Matrix4d matrixOf(const Pose& pose) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = pose.orientation.normalized().toRotationMatrix();
+  T.topRightCorner<3, 1>() = pose.position;
+  return T;
+}
+
+}  // namespace
+
+NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config)
+    : config_(config), map_(std::move(map), config.ndt, config.map) {
+  const Vector6d& p = config.lidar_pose;
+  Pose lidar;
+  lidar.position = p.head<3>();
+  lidar.orientation = quaternionFromRollPitchYaw(p[3], p[4], p[5]);
+  base_to_lidar_ = matrixOf(lidar);
+}
+
+ScanOutcome NdtPoseSource::process(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz) {
+  ++counters_.scans;
+  ScanOutcome out;
+  map_.update(predicted.position.head<2>());
+  const auto target = map_.target();
+  if (!target) {
+    ++counters_.no_map;
+    out.detail = "no map tile within reach of the predicted position";
+    return out;
+  }
+  const PointCloud cloud = preprocessScan(scan, config_.preprocess, vx, wz);
+  out.points_used = cloud.size();
+  if (cloud.empty()) {
+    ++counters_.empty_scan;
+    out.detail = "no point left after preprocessing";
+    return out;
+  }
+  // NDT aligns the LiDAR frame; the filter wants the vehicle: map_T_base = map_T_lidar * lidar_T_base.
+  const Eigen::Matrix4d guess = matrixOf(predicted) * base_to_lidar_;
+  out.alignment = align(*target, cloud, guess, config_.ndt);
+  counters_.align_ms_total += out.alignment.elapsed_ms;
+  switch (out.alignment.rejection) {
+    case AlignRejection::kNone: break;
+    case AlignRejection::kMaxIterations: ++counters_.max_iterations; break;
+    case AlignRejection::kOscillation: ++counters_.oscillation; break;
+    case AlignRejection::kLowScore: ++counters_.low_score; break;
+    case AlignRejection::kEmptySource: ++counters_.empty_scan; break;
+  }
+  if (!out.alignment.accepted()) {
+    out.detail = std::string(toString(out.alignment.rejection)) + ": " + out.alignment.detail;
+    return out;
+  }
+  const Eigen::Matrix4d base = out.alignment.transform * base_to_lidar_.inverse();
+  out.pose.stamp = stamp;
+  out.pose.pose.position = base.topRightCorner<3, 1>();
+  out.pose.pose.orientation = Eigen::Quaterniond(base.topLeftCorner<3, 3>()).normalized();
+  out.pose.covariance = out.alignment.covariance;
+  out.produced = true;
+  ++counters_.poses;
+  return out;
+}
+
+}  // namespace coloc::ndt

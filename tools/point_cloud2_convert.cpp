@@ -1,0 +1,84 @@
+#include "point_cloud2_convert.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "coloc/core/error.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+const io::PointField* field(const io::PointCloud2& m, std::initializer_list<const char*> names) {
+  for (const char* n : names)
+    for (const auto& f : m.fields)
+      if (f.name == n) return &f;
+  return nullptr;
+}
+
+double read(const std::uint8_t* at, std::uint8_t type) {
+  switch (type) {
+    case io::PointField::kFloat32: { float v; std::memcpy(&v, at, 4); return v; }
+    case io::PointField::kFloat64: { double v; std::memcpy(&v, at, 8); return v; }
+    case io::PointField::kUint32: { std::uint32_t v; std::memcpy(&v, at, 4); return v; }
+    case io::PointField::kInt32: { std::int32_t v; std::memcpy(&v, at, 4); return v; }
+    default: return std::nan("");
+  }
+}
+
+std::size_t sizeOf(std::uint8_t type) {
+  switch (type) {
+    case io::PointField::kInt8: case io::PointField::kUint8: return 1;
+    case io::PointField::kInt16: case io::PointField::kUint16: return 2;
+    case io::PointField::kInt32: case io::PointField::kUint32: case io::PointField::kFloat32: return 4;
+    case io::PointField::kFloat64: return 8;
+  }
+  return 0;
+}
+
+}  // namespace
+
+ndt::PointCloud toPointCloud(const io::PointCloud2& m) {
+  if (m.is_bigendian) throw Error("PointCloud2: big-endian point data is not supported");
+  const io::PointField* fx = field(m, {"x"});
+  const io::PointField* fy = field(m, {"y"});
+  const io::PointField* fz = field(m, {"z"});
+  if (!fx || !fy || !fz) throw Error("PointCloud2: no x, y and z fields");
+  const io::PointField* ft = field(m, {"time", "t", "time_stamp", "timestamp"});
+  for (const io::PointField* f : {fx, fy, fz, ft}) {
+    if (!f) continue;
+    const std::size_t size = sizeOf(f->datatype);
+    if (size == 0 || f->offset + size > m.point_step) throw Error("PointCloud2: field " + f->name + " lies outside point_step");
+    const std::uint8_t zeros[8] = {};
+    if (std::isnan(read(zeros, f->datatype)))
+      throw Error("PointCloud2: field " + f->name + " has a type coloc cannot read as a number");
+  }
+  const std::size_t count = static_cast<std::size_t>(m.width) * m.height;
+  if (m.point_step == 0 || m.row_step < static_cast<std::size_t>(m.width) * m.point_step ||
+      m.data.size() < static_cast<std::size_t>(m.row_step) * m.height)
+    throw Error("PointCloud2: data is shorter than height x row_step, or point_step is inconsistent");
+  ndt::PointCloud cloud;
+  cloud.points.reserve(count);
+  // Drivers give per-point time as seconds (float) relative to the sweep, nanoseconds (uint32, Ouster)
+  // or absolute seconds (float64): all become seconds relative to the first point.
+  std::vector<double> times;
+  for (std::uint32_t row = 0; row < m.height; ++row)
+    for (std::uint32_t col = 0; col < m.width; ++col) {
+      const std::uint8_t* p = m.data.data() + static_cast<std::size_t>(row) * m.row_step + static_cast<std::size_t>(col) * m.point_step;
+      const double x = read(p + fx->offset, fx->datatype), y = read(p + fy->offset, fy->datatype), z = read(p + fz->offset, fz->datatype);
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+      cloud.points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+      if (ft) times.push_back(read(p + ft->offset, ft->datatype));
+    }
+  if (ft && !times.empty()) {
+    double first = times.front();
+    for (double t : times) first = std::min(first, t);
+    const double scale = ft->datatype == io::PointField::kUint32 ? 1e-9 : 1.0;
+    cloud.times.reserve(times.size());
+    for (double t : times) cloud.times.push_back(static_cast<float>((t - first) * scale));
+  }
+  return cloud;
+}
+
+}  // namespace coloc::tools
