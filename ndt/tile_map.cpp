@@ -88,11 +88,14 @@ DynamicMap::~DynamicMap() {
 void DynamicMap::build(const Eigen::Vector2d& center) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<std::size_t> tiles = map_.tilesWithin(center, config_.radius);
+  std::map<std::size_t, PointCloud> loaded;
   PointCloud cloud;
   for (std::size_t t : tiles) {
-    PointCloud tile = map_.load(t);
+    auto kept = loaded_.find(t);
+    PointCloud& tile = loaded[t] = kept != loaded_.end() ? std::move(kept->second) : map_.load(t);
     cloud.points.insert(cloud.points.end(), tile.points.begin(), tile.points.end());
   }
+  loaded_ = std::move(loaded);  // tiles out of range are released here
   std::shared_ptr<const NdtTarget> next = cloud.empty() ? nullptr : std::make_shared<const NdtTarget>(cloud, ndt_);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);

@@ -7,6 +7,7 @@
 // background while alignment goes on against the current one, then swapped in.
 #include <Eigen/Core>
 #include <condition_variable>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -85,6 +86,9 @@ class DynamicMap {
   std::condition_variable wake_, idle_;
   std::shared_ptr<const NdtTarget> target_;
   DynamicMapStats stats_;
+  /// Tiles of the last build, kept so that the next build reads only the tiles new to it. Touched by
+  /// build() alone, which never runs twice at once.
+  std::map<std::size_t, PointCloud> loaded_;
   bool has_center_ = false;
   Eigen::Vector2d center_ = Eigen::Vector2d::Zero();  ///< of the last build requested
   bool pending_ = false, busy_ = false, stopping_ = false;
