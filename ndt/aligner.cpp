@@ -1,6 +1,7 @@
 #include "coloc/ndt/aligner.hpp"
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <chrono>
 #include <mutex>
 #include <cmath>
@@ -121,14 +122,15 @@ Matrix6d laplaceCovariance(const Matrix6d& hessian, const Vector6d& floor) {
 
 }  // namespace
 
-AlignResult align(const NdtTarget& target, const PointCloud& source, const Eigen::Matrix4d& guess, const NdtConfig& config) {
-  if (!guess.allFinite()) throw Error("NDT align: the initial guess is not finite");
-  const NdtTarget::Impl& t = target.impl();
+namespace {
+
+// The alignment proper, on a source cloud whose points are all finite.
+AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, const Eigen::Matrix4d& guess, const NdtConfig& config) {
   AlignResult result;
   result.transform = guess;
   if (source.empty()) {
     result.rejection = AlignRejection::kEmptySource;
-    result.detail = "the source cloud is empty";
+    result.detail = "the source cloud is empty (or has no finite point)";
     return result;
   }
   const auto start = Clock::now();
@@ -173,6 +175,21 @@ AlignResult align(const NdtTarget& target, const PointCloud& source, const Eigen
   }
   result.detail = why.str();
   return result;
+}
+
+}  // namespace
+
+AlignResult align(const NdtTarget& target, const PointCloud& source, const Eigen::Matrix4d& guess, const NdtConfig& config) {
+  if (!guess.allFinite()) throw Error("NDT align: the initial guess is not finite");
+  const NdtTarget::Impl& t = target.impl();
+  // Non-finite points carry no information and would poison the voxel lookup: leave them out.
+  PointCloud finite;
+  const bool all_finite = std::all_of(source.points.begin(), source.points.end(), [](const Eigen::Vector3f& p) { return p.allFinite(); });
+  if (!all_finite)
+    for (const Eigen::Vector3f& p : source.points)
+      if (p.allFinite()) finite.points.push_back(p);
+  const PointCloud& source_used = all_finite ? source : finite;
+  return alignFinite(t, source_used, guess, config);
 }
 
 }  // namespace coloc::ndt

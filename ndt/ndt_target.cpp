@@ -31,9 +31,14 @@ void fillLookup(const pcl::VoxelGridCovariance<PclPoint>& const_grid, VoxelLooku
 
 PclCloud::Ptr toPcl(const PointCloud& cloud) {
   auto out = std::make_shared<PclCloud>();
-  out->resize(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) (*out)[i].getVector3fMap() = cloud.points[i];
-  out->width = static_cast<std::uint32_t>(cloud.size());
+  out->reserve(cloud.size());
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite()) continue;  // PCL's voxel grid trusts is_dense; non-finite points never reach it
+    PclPoint q;
+    q.getVector3fMap() = p;
+    out->push_back(q);
+  }
+  out->width = static_cast<std::uint32_t>(out->size());
   out->height = 1;
   out->is_dense = true;
   return out;
@@ -46,6 +51,7 @@ NdtTarget::NdtTarget(const PointCloud& map, const NdtConfig& config) : impl_(std
   d.config = config;
   d.constants = scoreConstants(config.resolution, config.outlier_ratio);
   d.cloud = toPcl(map);
+  if (d.cloud->empty()) throw Error("NDT target: the map cloud holds no finite point");
   if (config.backend == NdtBackend::kPcl) {
     d.pcl_ndt = std::make_shared<ExposedNdt>();
     d.pcl_ndt->setResolution(static_cast<float>(config.resolution));

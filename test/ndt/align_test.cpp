@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
 #include <Eigen/Geometry>
 
 #include "coloc/core/error.hpp"
@@ -139,6 +141,32 @@ TEST(Align, EmptySourceIsRejectedNotCrashed) {
   Eigen::Matrix4d bad = Eigen::Matrix4d::Identity();
   bad(0, 3) = std::nan("");
   EXPECT_THROW(align(target, map, bad, NdtConfig{}), Error);
+}
+
+}  // namespace
+}  // namespace coloc::ndt
+
+namespace coloc::ndt {
+namespace {
+
+TEST(Align, NaNFilledCloudsGiveErrorsOrRejectionsNotCrashes) {
+  const float nan = std::nanf("");
+  PointCloud nan_map;
+  for (int i = 0; i < 100; ++i) nan_map.points.emplace_back(nan, 1.0f, 2.0f);
+  EXPECT_THROW(NdtTarget(nan_map, NdtConfig{}), Error);
+  PointCloud map;
+  for (int i = 0; i < 2000; ++i) map.points.emplace_back(0.01f * (i % 100), 0.01f * (i / 100), 0.001f * (i % 7));
+  const NdtTarget target(map, NdtConfig{});
+  PointCloud nan_scan;
+  for (int i = 0; i < 50; ++i) nan_scan.points.emplace_back(nan, nan, nan);
+  EXPECT_EQ(align(target, nan_scan, Eigen::Matrix4d::Identity(), NdtConfig{}).rejection, AlignRejection::kEmptySource);
+  // A few NaN among good points are left out, the rest aligns.
+  PointCloud mixed = map;
+  mixed.points[3] = Eigen::Vector3f(nan, 0, 0);
+  mixed.points[7] = Eigen::Vector3f(0, std::numeric_limits<float>::infinity(), 0);
+  const AlignResult r = align(target, mixed, Eigen::Matrix4d::Identity(), NdtConfig{});
+  EXPECT_NE(r.rejection, AlignRejection::kEmptySource);
+  EXPECT_TRUE(r.transform.allFinite());
 }
 
 }  // namespace
