@@ -8,5 +8,7 @@ void addFuseCommand(CLI::App& app);
 void addConvertCommand(CLI::App& app);
 void addConfigCommand(CLI::App& app);
 void addAlignCommand(CLI::App& app);
+void addRsuListenCommand(CLI::App& app);
+void addRsuPublishCommand(CLI::App& app);
 
 }  // namespace coloc::tools

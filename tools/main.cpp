@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   coloc::tools::addConvertCommand(app);
   coloc::tools::addConfigCommand(app);
   coloc::tools::addAlignCommand(app);
+  coloc::tools::addRsuListenCommand(app);
+  coloc::tools::addRsuPublishCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,110 @@
+#pragma once
+// Roadside fixes and vehicle dimensions over Fast DDS, exactly as ROS 2 puts them on the wire: topic
+// "rt/rsu/<id>/fix" of type geometry_msgs::msg::dds_::PoseWithCovarianceStamped_ and
+// "rt/vehicle/dimensions" of type coloc_msgs::msg::dds_::VehicleDimensions_, XCDR1, no keys. A ROS 2
+// node publishing geometry_msgs/msg/PoseWithCovarianceStamped on /rsu/<id>/fix reaches coloc with no
+// bridge. No Fast DDS type appears in this header.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coloc/core/time.hpp"
+#include "coloc/rsu_client/rsu_fix.hpp"
+
+namespace coloc::rsu_client {
+
+/// DDS Security (PKI-DH authentication, access control, AES-GCM). Off must be said, never assumed.
+struct SecurityConfig {
+  bool enabled = false;
+  std::string identity_ca;           ///< PEM of the CA that signs participant certificates
+  std::string identity_certificate;  ///< this participant's certificate (PEM)
+  std::string private_key;           ///< its key (PEM)
+  std::string permissions_ca;        ///< PEM of the CA that signs governance and permissions
+  std::string governance;            ///< signed governance document (S/MIME .p7s)
+  std::string permissions;           ///< signed permissions document (S/MIME .p7s)
+};
+
+struct DdsConfig {
+  int domain = 0;           ///< ROS_DOMAIN_ID
+  bool reliable = false;    ///< false: ROS 2 sensor-data QoS (best effort)
+  int depth = 5;            ///< keep-last depth
+  /// UDP on 127.0.0.1 with unicast discovery: works in containers without shared memory and sends
+  /// nothing beyond the machine. Off: default Fast DDS transports (UDP multicast discovery on every
+  /// interface, shared memory).
+  bool loopback_only = true;
+  std::string participant_name = "coloc";
+  SecurityConfig security;
+};
+
+/// The ROS topic a fix of this RSU travels on; DDS adds the "rt" prefix.
+std::string fixTopic(const std::string& rsu_id);
+inline constexpr const char* kVehicleDimensionsTopic = "/vehicle/dimensions";
+
+struct VehicleDimensions {
+  Stamp stamp = 0;
+  std::uint32_t station_id = 0;
+  double length = 0.0, width = 0.0;
+  double reference_x = 0.0, reference_y = 0.0;
+};
+
+/// Nanoseconds since the Unix epoch on the system clock: the vehicle's "now" for received messages.
+Stamp systemNow();
+
+class FixSubscriber {
+ public:
+  /// Called on a DDS thread for every sample: the fix and its arrival time (systemNow()).
+  using Callback = std::function<void(const RsuFix& fix, Stamp received)>;
+  /// Subscribes to the fix topic of each RSU id. Throws coloc::Error if DDS refuses (bad security
+  /// files, ...), naming the reason.
+  FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback);
+  ~FixSubscriber();
+  /// Writers currently matched, over all RSU topics.
+  int matchedPublishers() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class FixPublisher {
+ public:
+  FixPublisher(const DdsConfig& config, const std::string& rsu_id);
+  ~FixPublisher();
+  /// Publishes with frame "map", the fix's x and y, its variance on x and y and +inf elsewhere.
+  void publish(const RsuFix& fix, double variance);
+  /// Waits until at least `count` readers are matched; false on timeout.
+  bool waitForSubscribers(int count, std::chrono::milliseconds timeout);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class DimensionsPublisher {
+ public:
+  explicit DimensionsPublisher(const DdsConfig& config);
+  ~DimensionsPublisher();
+  void publish(const VehicleDimensions& dimensions);
+  bool waitForSubscribers(int count, std::chrono::milliseconds timeout);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class DimensionsSubscriber {
+ public:
+  using Callback = std::function<void(const VehicleDimensions&)>;
+  DimensionsSubscriber(const DdsConfig& config, Callback callback);
+  ~DimensionsSubscriber();
+  int matchedPublishers() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace coloc::rsu_client

@@ -1,0 +1,54 @@
+#pragma once
+// The roadside units a vehicle trusts: where each stands in the map, which LiDAR it carries, how far
+// it sees, and the identity its DDS certificate carries. Loaded from config/rsu.yaml.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace coloc::rsu_client {
+
+/// A roadside LiDAR model with the paper's figures.
+struct LidarModel {
+  std::string name;
+  double sigma;  ///< the paper's per-LiDAR figure for x and y
+  double range;  ///< m, effective range for vehicle detection
+};
+
+/// The models coloc knows: VLP-16 (0.01486, 30 m) and VLP-32C (0.00681, 50 m).
+const std::vector<LidarModel>& lidarModels();
+const LidarModel* findLidarModel(const std::string& name);
+
+/// How the model's sigma becomes a covariance. The paper writes sigma values into Autoware's
+/// covariance matrix where Autoware's NDT puts 0.0225, a variance: `published` keeps that placement
+/// (variance = sigma, the figure read in m^2); `standard_deviation` reads it as metres (variance = sigma^2).
+enum class CovariancePlacement { kPublished, kStandardDeviation };
+
+struct RsuInfo {
+  std::string id;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< map frame, m
+  double height = 2.0;                                  ///< m, LiDAR above the road
+  LidarModel lidar;
+  double coverage_radius = 0.0;  ///< m; fixes farther than this from the RSU are refused
+  std::string identity;          ///< subject of its DDS Security certificate, e.g. "CN=rsu_a"
+};
+
+class RsuRegistry {
+ public:
+  /// Throws coloc::Error naming the file, line and key for unknown keys, unknown LiDAR models,
+  /// duplicate ids and values out of range.
+  static RsuRegistry load(const std::string& path);
+  static RsuRegistry parse(const std::string& yaml_text, const std::string& source_name);
+
+  const RsuInfo* find(const std::string& id) const;
+  const std::vector<RsuInfo>& rsus() const { return rsus_; }
+  CovariancePlacement placement() const { return placement_; }
+  /// The x/y variance a fix from this RSU carries.
+  double variance(const RsuInfo& rsu) const;
+
+ private:
+  std::vector<RsuInfo> rsus_;
+  CovariancePlacement placement_ = CovariancePlacement::kPublished;
+};
+
+}  // namespace coloc::rsu_client

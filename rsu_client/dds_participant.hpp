@@ -1,0 +1,23 @@
+#pragma once
+// One Fast DDS participant set up as coloc needs it (transport, discovery, security), shared by the
+// publishers and subscribers of rsu_client. Fast DDS headers stay in rsu_client's .cpp files.
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <string>
+
+#include "coloc/rsu_client/dds_transport.hpp"
+
+namespace coloc::rsu_client {
+
+/// Creates a participant or throws coloc::Error with the reason.
+eprosima::fastdds::dds::DomainParticipant* createParticipant(const DdsConfig& config);
+/// Deletes every entity of the participant, then the participant.
+void destroyParticipant(eprosima::fastdds::dds::DomainParticipant* participant);
+/// "/rsu/a/fix" -> "rt/rsu/a/fix", as rmw_fastrtps names ROS topics.
+std::string ddsTopicName(const std::string& ros_topic);
+/// Finds or creates the topic of a registered type.
+eprosima::fastdds::dds::Topic* topicFor(eprosima::fastdds::dds::DomainParticipant* participant, const std::string& ros_topic,
+                                        eprosima::fastdds::dds::TypeSupport& type);
+
+}  // namespace coloc::rsu_client

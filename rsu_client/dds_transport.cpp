@@ -1,0 +1,244 @@
+#include "coloc/rsu_client/dds_transport.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+#include "PoseWithCovarianceStampedPubSubTypes.h"
+#include "VehicleDimensionsPubSubTypes.h"
+#include "coloc/core/error.hpp"
+#include "dds_participant.hpp"
+
+namespace coloc::rsu_client {
+
+namespace dds = eprosima::fastdds::dds;
+using RosPose = geometry_msgs::msg::PoseWithCovarianceStamped;
+using RosDimensions = coloc_msgs::msg::VehicleDimensions;
+
+std::string fixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/fix"; }
+
+Stamp systemNow() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+namespace {
+
+dds::DataReaderQos readerQos(const DdsConfig& c) {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = c.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = c.depth;
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  return q;
+}
+
+dds::DataWriterQos writerQos(const DdsConfig& c) {
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = c.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = c.depth;
+  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  return q;
+}
+
+void setStamp(std_msgs::msg::Header& header, Stamp stamp, const std::string& frame) {
+  const Stamp sec = stamp >= 0 ? stamp / kNanosPerSecond : (stamp - kNanosPerSecond + 1) / kNanosPerSecond;
+  header.stamp().sec(static_cast<std::int32_t>(sec));
+  header.stamp().nanosec(static_cast<std::uint32_t>(stamp - sec * kNanosPerSecond));
+  header.frame_id(frame);
+}
+
+Stamp stampOf(const std_msgs::msg::Header& header) { return fromRosTime(header.stamp().sec(), header.stamp().nanosec()); }
+
+// Counts matched remote endpoints so that callers can wait for discovery.
+class MatchCounter : public dds::DataWriterListener {
+ public:
+  void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override {
+    matched = status.current_count;
+  }
+  std::atomic<int> matched{0};
+};
+
+bool waitFor(const std::atomic<int>& matched, int count, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (matched.load() < count) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+}  // namespace
+
+// ---- fixes -------------------------------------------------------------------------------------
+
+struct FixSubscriber::Impl : public dds::DataReaderListener {
+  dds::DomainParticipant* participant = nullptr;
+  dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
+  std::vector<std::pair<dds::DataReader*, std::string>> readers;  ///< reader and its RSU id
+  Callback callback;
+  std::atomic<int> matched{0};
+
+  void on_data_available(dds::DataReader* reader) override {
+    std::string rsu_id;
+    for (const auto& [r, id] : readers)
+      if (r == reader) rsu_id = id;
+    RosPose msg;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const Stamp received = systemNow();
+      RsuFix fix;
+      fix.rsu_id = rsu_id;
+      fix.stamp = stampOf(msg.header());
+      fix.x = msg.pose().pose().position().x();
+      fix.y = msg.pose().pose().position().y();
+      // A yaw is present only if the sender gave it a finite variance.
+      const double yaw_variance = msg.pose().covariance()[35];
+      if (std::isfinite(yaw_variance) && yaw_variance > 0.0) {
+        const auto& q = msg.pose().pose().orientation();
+        fix.yaw = std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()), 1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+      }
+      callback(fix, received);
+    }
+  }
+  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
+    matched += status.current_count_change;
+  }
+};
+
+FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->callback = std::move(callback);
+  impl_->participant = createParticipant(config);
+  dds::Subscriber* subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (!subscriber) throw Error("DDS: cannot create a subscriber");
+  impl_->readers.reserve(rsu_ids.size());
+  for (const std::string& id : rsu_ids) {
+    dds::Topic* topic = topicFor(impl_->participant, fixTopic(id), impl_->type);
+    // Readers are listed before they exist so that the listener never sees an unknown one.
+    impl_->readers.emplace_back(nullptr, id);
+    dds::DataReader* reader = subscriber->create_datareader(topic, readerQos(config), impl_.get());
+    if (!reader) throw Error("DDS: cannot subscribe to " + ddsTopicName(fixTopic(id)));
+    impl_->readers.back().first = reader;
+  }
+}
+
+FixSubscriber::~FixSubscriber() { destroyParticipant(impl_->participant); }
+int FixSubscriber::matchedPublishers() const { return impl_->matched.load(); }
+
+struct FixPublisher::Impl {
+  dds::DomainParticipant* participant = nullptr;
+  dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
+  dds::DataWriter* writer = nullptr;
+  MatchCounter listener;
+};
+
+FixPublisher::FixPublisher(const DdsConfig& config, const std::string& rsu_id) : impl_(std::make_unique<Impl>()) {
+  impl_->participant = createParticipant(config);
+  dds::Publisher* publisher = impl_->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  if (!publisher) throw Error("DDS: cannot create a publisher");
+  dds::Topic* topic = topicFor(impl_->participant, fixTopic(rsu_id), impl_->type);
+  impl_->writer = publisher->create_datawriter(topic, writerQos(config), &impl_->listener);
+  if (!impl_->writer) throw Error("DDS: cannot publish on " + ddsTopicName(fixTopic(rsu_id)) + " (not permitted?)");
+}
+
+FixPublisher::~FixPublisher() { destroyParticipant(impl_->participant); }
+
+void FixPublisher::publish(const RsuFix& fix, double variance) {
+  RosPose msg;
+  setStamp(msg.header(), fix.stamp, "map");
+  msg.pose().pose().position().x(fix.x);
+  msg.pose().pose().position().y(fix.y);
+  msg.pose().pose().position().z(0.0);
+  const double yaw = fix.yaw.value_or(0.0);
+  msg.pose().pose().orientation().z(std::sin(0.5 * yaw));
+  msg.pose().pose().orientation().w(std::cos(0.5 * yaw));
+  std::array<double, 36> covariance{};
+  covariance[0] = covariance[7] = variance;
+  covariance[14] = covariance[21] = covariance[28] = covariance[35] = std::numeric_limits<double>::infinity();
+  msg.pose().covariance(covariance);
+  impl_->writer->write(&msg);
+}
+
+bool FixPublisher::waitForSubscribers(int count, std::chrono::milliseconds timeout) {
+  return waitFor(impl_->listener.matched, count, timeout);
+}
+
+// ---- vehicle dimensions ------------------------------------------------------------------------
+
+struct DimensionsPublisher::Impl {
+  dds::DomainParticipant* participant = nullptr;
+  dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
+  dds::DataWriter* writer = nullptr;
+  MatchCounter listener;
+};
+
+DimensionsPublisher::DimensionsPublisher(const DdsConfig& config) : impl_(std::make_unique<Impl>()) {
+  impl_->participant = createParticipant(config);
+  dds::Publisher* publisher = impl_->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  dds::Topic* topic = topicFor(impl_->participant, kVehicleDimensionsTopic, impl_->type);
+  impl_->writer = publisher ? publisher->create_datawriter(topic, writerQos(config), &impl_->listener) : nullptr;
+  if (!impl_->writer) throw Error(std::string("DDS: cannot publish on ") + ddsTopicName(kVehicleDimensionsTopic));
+}
+
+DimensionsPublisher::~DimensionsPublisher() { destroyParticipant(impl_->participant); }
+
+void DimensionsPublisher::publish(const VehicleDimensions& d) {
+  RosDimensions msg;
+  setStamp(msg.header(), d.stamp, "base_link");
+  msg.station_id(d.station_id);
+  msg.length(d.length);
+  msg.width(d.width);
+  msg.reference_x(d.reference_x);
+  msg.reference_y(d.reference_y);
+  impl_->writer->write(&msg);
+}
+
+bool DimensionsPublisher::waitForSubscribers(int count, std::chrono::milliseconds timeout) {
+  return waitFor(impl_->listener.matched, count, timeout);
+}
+
+struct DimensionsSubscriber::Impl : public dds::DataReaderListener {
+  dds::DomainParticipant* participant = nullptr;
+  dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
+  Callback callback;
+  std::atomic<int> matched{0};
+
+  void on_data_available(dds::DataReader* reader) override {
+    RosDimensions msg;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      callback({stampOf(msg.header()), msg.station_id(), msg.length(), msg.width(), msg.reference_x(), msg.reference_y()});
+    }
+  }
+  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
+    matched += status.current_count_change;
+  }
+};
+
+DimensionsSubscriber::DimensionsSubscriber(const DdsConfig& config, Callback callback) : impl_(std::make_unique<Impl>()) {
+  impl_->callback = std::move(callback);
+  impl_->participant = createParticipant(config);
+  dds::Subscriber* subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  dds::Topic* topic = topicFor(impl_->participant, kVehicleDimensionsTopic, impl_->type);
+  if (!subscriber || !subscriber->create_datareader(topic, readerQos(config), impl_.get()))
+    throw Error(std::string("DDS: cannot subscribe to ") + ddsTopicName(kVehicleDimensionsTopic));
+}
+
+DimensionsSubscriber::~DimensionsSubscriber() { destroyParticipant(impl_->participant); }
+int DimensionsSubscriber::matchedPublishers() const { return impl_->matched.load(); }
+
+}  // namespace coloc::rsu_client

@@ -1,0 +1,64 @@
+#include "coloc/rsu_client/rsu_fix.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace coloc::rsu_client {
+
+const char* toString(FixRejection reason) {
+  switch (reason) {
+    case FixRejection::kNone: return "none";
+    case FixRejection::kUnknownRsu: return "unknown_rsu";
+    case FixRejection::kNonFinite: return "non_finite";
+    case FixRejection::kOutOfCoverage: return "out_of_coverage";
+    case FixRejection::kStale: return "stale";
+    case FixRejection::kFromFuture: return "from_future";
+    case FixRejection::kDuplicate: return "duplicate";
+  }
+  return "?";
+}
+
+FixChecker::FixChecker(RsuRegistry registry, FixCheckConfig config) : registry_(std::move(registry)), config_(config) {}
+
+FixVerdict FixChecker::check(const RsuFix& fix, Stamp now) {
+  FixCounters& c = counters_[fix.rsu_id];
+  ++c.received;
+  FixVerdict v;
+  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) {
+    ++counter;
+    v.rejection = reason;
+    std::ostringstream out;
+    out << "fix from '" << fix.rsu_id << "' stamped " << formatSeconds(fix.stamp) << " rejected (" << toString(reason) << "): " << why;
+    v.detail = out.str();
+    return v;
+  };
+  const RsuInfo* rsu = registry_.find(fix.rsu_id);
+  if (!rsu) return reject(FixRejection::kUnknownRsu, "no such RSU in the registry", c.unknown_rsu);
+  if (!std::isfinite(fix.x) || !std::isfinite(fix.y) || (fix.yaw && !std::isfinite(*fix.yaw)))
+    return reject(FixRejection::kNonFinite, "position or yaw is not finite", c.non_finite);
+  const double distance = (Eigen::Vector2d(fix.x, fix.y) - rsu->position).norm();
+  if (distance > rsu->coverage_radius) {
+    std::ostringstream why;
+    why << "the fix lies " << distance << " m from the RSU, beyond its coverage of " << rsu->coverage_radius << " m";
+    return reject(FixRejection::kOutOfCoverage, why.str(), c.out_of_coverage);
+  }
+  if (fix.stamp > now + fromSeconds(config_.future_tolerance))
+    return reject(FixRejection::kFromFuture, "stamped " + formatSeconds(fix.stamp - now) + " s after its arrival", c.from_future);
+  if (fix.stamp < now - fromSeconds(config_.max_age))
+    return reject(FixRejection::kStale, formatSeconds(now - fix.stamp) + " s old (limit " + std::to_string(config_.max_age) + " s)", c.stale);
+  std::deque<Stamp>& seen = recent_[fix.rsu_id];
+  while (!seen.empty() && seen.front() < now - fromSeconds(config_.max_age)) seen.pop_front();
+  if (std::find(seen.begin(), seen.end(), fix.stamp) != seen.end())
+    return reject(FixRejection::kDuplicate, "a fix with this stamp was already received", c.duplicate);
+  seen.push_back(fix.stamp);
+  ++c.accepted;
+  const double variance = registry_.variance(*rsu);
+  v.measurement.stamp = fix.stamp;
+  v.measurement.pose.position = {fix.x, fix.y, 0.0};
+  v.measurement.covariance = Matrix6d::Zero();
+  v.measurement.covariance.diagonal() << variance, variance, kInfinity, kInfinity, kInfinity, kInfinity;
+  return v;
+}
+
+}  // namespace coloc::rsu_client

@@ -1,0 +1,206 @@
+// `coloc rsu-listen` and `coloc rsu-publish`: the vehicle's and a roadside unit's ends of the V2I link,
+// over Fast DDS as ROS 2 puts it on the wire.
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "coloc/core/error.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
+#include "coloc/rsu_client/link_emulator.hpp"
+#include "commands.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+struct DdsOptions {
+  int domain = 0;
+  bool reliable = false;
+  bool any_interface = false;
+  std::string security_dir;  ///< folder with ca.pem, <name>.pem, <name>_key.pem, governance.p7s, <name>_permissions.p7s
+  std::string name;
+};
+
+void addDdsOptions(CLI::App* cmd, DdsOptions& o) {
+  cmd->add_option("--domain", o.domain, "DDS domain (ROS_DOMAIN_ID)")->capture_default_str();
+  cmd->add_flag("--reliable", o.reliable, "reliable QoS instead of ROS 2 sensor data (best effort, keep last 5)");
+  cmd->add_flag("--any-interface", o.any_interface, "Fast DDS default transports instead of UDP on loopback");
+  cmd->add_option("--security", o.security_dir,
+                  "folder with DDS Security files: identity_ca.pem, permissions_ca.pem, governance.p7s, NAME.pem, "
+                  "NAME_key.pem, NAME_permissions.p7s (NAME: --name)");
+}
+
+rsu_client::DdsConfig ddsConfig(const DdsOptions& o, const std::string& default_name) {
+  rsu_client::DdsConfig c;
+  c.domain = o.domain;
+  c.reliable = o.reliable;
+  c.loopback_only = !o.any_interface;
+  c.participant_name = o.name.empty() ? default_name : o.name;
+  if (!o.security_dir.empty()) {
+    const std::string d = o.security_dir + "/", n = c.participant_name;
+    c.security = {true, d + "identity_ca.pem", d + n + ".pem", d + n + "_key.pem", d + "permissions_ca.pem", d + "governance.p7s",
+                  d + n + "_permissions.p7s"};
+  }
+  return c;
+}
+
+void printSecurity(const rsu_client::DdsConfig& c) {
+  if (c.security.enabled)
+    std::printf("DDS Security on: PKI-DH authentication, access control, AES-GCM (identity %s)\n", c.security.identity_certificate.c_str());
+  else
+    std::printf("DDS Security OFF: fixes are accepted from any participant that publishes on the topics\n");
+  std::fflush(stdout);
+}
+
+std::vector<rsu_client::RsuFix> fixesFromFile(const std::string& path, const std::string& rsu) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the fix file");
+  std::vector<rsu_client::RsuFix> fixes;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    double t, x, y;
+    char c1, c2;
+    if (!(s >> t >> c1 >> x >> c2 >> y) || c1 != ',' || c2 != ',')
+      throw Error(path + ":" + std::to_string(number) + ": expected 't_offset_s,x,y'");
+    fixes.push_back({fromSeconds(t), rsu, x, y, std::nullopt});
+  }
+  return fixes;
+}
+
+}  // namespace
+
+void addRsuListenCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("rsu-listen", "Receive roadside fixes over DDS and print each with its verdict");
+  static DdsOptions dds;
+  static std::string registry_path = "config/rsu.yaml";
+  static int count = 0;
+  static double timeout = 0.0;
+  static bool dimensions = false;
+  cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
+  cmd->add_option("--count", count, "exit after this many fixes (0 = run until --timeout or Ctrl-C)");
+  cmd->add_option("--timeout", timeout, "exit after this many seconds (0 = no limit)");
+  cmd->add_flag("--dimensions", dimensions, "also print vehicle dimensions published on /vehicle/dimensions");
+  cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
+  addDdsOptions(cmd, dds);
+  cmd->callback([] {
+    rsu_client::FixChecker checker(rsu_client::RsuRegistry::load(registry_path));
+    std::vector<std::string> ids;
+    for (const auto& r : checker.registry().rsus()) ids.push_back(r.id);
+    const rsu_client::DdsConfig config = ddsConfig(dds, "vehicle");
+    printSecurity(config);
+    std::mutex mutex;
+    std::atomic<int> received{0};
+    rsu_client::FixSubscriber subscriber(config, ids, [&](const rsu_client::RsuFix& fix, Stamp now) {
+      std::lock_guard<std::mutex> lock(mutex);
+      const rsu_client::FixVerdict v = checker.check(fix, now);
+      if (v.accepted())
+        std::printf("fix %s %s x=%.3f y=%.3f accepted (variance %.5f, delay %.1f ms)\n", fix.rsu_id.c_str(), formatSeconds(fix.stamp).c_str(),
+                    fix.x, fix.y, v.measurement.covariance(0, 0), 1e3 * toSeconds(now - fix.stamp));
+      else
+        std::printf("%s\n", v.detail.c_str());
+      std::fflush(stdout);
+      ++received;
+    });
+    std::unique_ptr<rsu_client::DimensionsSubscriber> dims;
+    if (dimensions)
+      dims = std::make_unique<rsu_client::DimensionsSubscriber>(config, [&](const rsu_client::VehicleDimensions& d) {
+        std::lock_guard<std::mutex> lock(mutex);
+        std::printf("dimensions station %u length %.3f width %.3f reference (%.3f, %.3f)\n", d.station_id, d.length, d.width,
+                    d.reference_x, d.reference_y);
+        std::fflush(stdout);
+      });
+    std::printf("listening on %zu RSU topics (%s), domain %d\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
+                config.domain);
+    std::fflush(stdout);
+    const auto start = std::chrono::steady_clock::now();
+    while ((count == 0 || received.load() < count) &&
+           (timeout <= 0.0 || std::chrono::steady_clock::now() - start < std::chrono::duration<double>(timeout)))
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [id, c] : checker.counters())
+      std::printf("summary %s: received %llu accepted %llu unknown_rsu %llu non_finite %llu out_of_coverage %llu stale %llu "
+                  "from_future %llu duplicate %llu\n",
+                  id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted, (unsigned long long)c.unknown_rsu,
+                  (unsigned long long)c.non_finite, (unsigned long long)c.out_of_coverage, (unsigned long long)c.stale,
+                  (unsigned long long)c.from_future, (unsigned long long)c.duplicate);
+  });
+}
+
+void addRsuPublishCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("rsu-publish", "Publish roadside fixes over DDS as an RSU would");
+  static DdsOptions dds;
+  static std::string registry_path = "config/rsu.yaml", rsu, from;
+  static int generate = 0, wait_subscribers = 1;
+  static double rate = 10.0, wait_timeout = 10.0, speed = 10.0;
+  static rsu_client::LinkConfig link;
+  static std::vector<double> dimensions;
+  cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
+  cmd->add_option("--rsu", rsu, "the RSU id to publish as")->required();
+  cmd->add_option("--from", from, "fixes from a CSV file: t_offset_s,x,y per line");
+  cmd->add_option("--generate", generate, "generate this many fixes of a vehicle driving past the RSU");
+  cmd->add_option("--speed", speed, "speed of the generated vehicle, m/s")->capture_default_str();
+  cmd->add_option("--rate", rate, "fixes per second")->capture_default_str();
+  cmd->add_option("--wait-subscribers", wait_subscribers, "wait for this many listeners before sending")->capture_default_str();
+  cmd->add_option("--wait-timeout", wait_timeout, "seconds to wait for them")->capture_default_str();
+  cmd->add_option("--dimensions", dimensions, "also publish vehicle dimensions: station_id length width")->expected(3);
+  cmd->add_option("--delay", link.delay, "emulated link delay, s")->capture_default_str();
+  cmd->add_option("--jitter", link.jitter, "emulated delay jitter (standard deviation), s")->capture_default_str();
+  cmd->add_option("--loss", link.loss, "emulated independent loss probability")->capture_default_str();
+  cmd->add_flag("--burst", link.burst, "bursty (Gilbert-Elliott) loss instead of independent");
+  cmd->add_option("--seed", link.seed, "seed of the link emulation")->capture_default_str();
+  cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix); default: the RSU id");
+  addDdsOptions(cmd, dds);
+  cmd->callback([] {
+    const rsu_client::RsuRegistry registry = rsu_client::RsuRegistry::load(registry_path);
+    const rsu_client::RsuInfo* info = registry.find(rsu);
+    if (!info) throw Error(registry_path + ": no RSU '" + rsu + "'");
+    std::vector<rsu_client::RsuFix> fixes;
+    if (!from.empty()) fixes = fixesFromFile(from, rsu);
+    for (int i = 0; i < generate; ++i) {  // a straight pass 3 m from the RSU, centred on it
+      const double t = i / rate, along = -0.5 * speed * generate / rate + speed * t;
+      fixes.push_back({fromSeconds(t), rsu, info->position.x() + along, info->position.y() + 3.0, std::nullopt});
+    }
+    if (fixes.empty()) throw Error("rsu-publish: nothing to send (give --from or --generate)");
+    const rsu_client::DdsConfig config = ddsConfig(dds, rsu);
+    printSecurity(config);
+    rsu_client::FixPublisher publisher(config, rsu);
+    std::unique_ptr<rsu_client::DimensionsPublisher> dims;
+    if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
+    if (wait_subscribers > 0 &&
+        !publisher.waitForSubscribers(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000))))
+      throw Error("rsu-publish: no listener matched within " + std::to_string(wait_timeout) + " s");
+    if (dims) {
+      dims->waitForSubscribers(1, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)));
+      dims->publish({rsu_client::systemNow(), static_cast<std::uint32_t>(dimensions[0]), dimensions[1], dimensions[2], 0.0, 0.0});
+    }
+    rsu_client::LinkEmulator emulator(link);
+    const Stamp start = rsu_client::systemNow();
+    int sent = 0, dropped = 0;
+    for (const rsu_client::RsuFix& planned : fixes) {
+      // Fixes are stamped at capture on the vehicle's clock; the emulated link decides when (and if) each arrives.
+      rsu_client::RsuFix fix = planned;
+      fix.stamp = start + planned.stamp;
+      std::this_thread::sleep_until(std::chrono::system_clock::time_point(std::chrono::nanoseconds(fix.stamp)));
+      const std::optional<Stamp> delivery = emulator.transmit(fix.stamp);
+      if (!delivery) {
+        ++dropped;
+        continue;
+      }
+      std::this_thread::sleep_until(std::chrono::system_clock::time_point(std::chrono::nanoseconds(*delivery)));
+      publisher.publish(fix, registry.variance(*info));
+      ++sent;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // let the last samples leave
+    std::printf("published %d fixes as %s, %d dropped by the emulated link\n", sent, rsu.c_str(), dropped);
+  });
+}
+
+}  // namespace coloc::tools
