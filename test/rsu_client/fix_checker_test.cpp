@@ -1,0 +1,100 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "coloc/fusion/localizer.hpp"
+#include "coloc/rsu_client/rsu_fix.hpp"
+
+namespace coloc::rsu_client {
+namespace {
+
+constexpr Stamp kNow = 1'700'000'000'000'000'000LL;
+
+FixChecker checker() {
+  return FixChecker(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n", "test"));
+}
+
+TEST(FixChecker, ValidFixBecomesATwoDimensionalMeasurementWithInfiniteElsewhere) {
+  FixChecker c = checker();
+  const FixVerdict v = c.check({kNow - 20'000'000, "rsu_a", 110.0, 2.0, std::nullopt}, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_EQ(v.measurement.stamp, kNow - 20'000'000);  // capture time, not arrival
+  EXPECT_EQ(v.measurement.covariance(0, 0), 0.01486);
+  EXPECT_EQ(v.measurement.covariance(1, 1), 0.01486);
+  for (int i = 2; i < 6; ++i) EXPECT_EQ(v.measurement.covariance(i, i), kInfinity);
+  EXPECT_EQ(c.counters().at("rsu_a").accepted, 1u);
+}
+
+TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
+  FixChecker c = checker();
+  const double nan = std::nan("");
+  struct Case {
+    RsuFix fix;
+    FixRejection reason;
+  };
+  const Case cases[] = {
+      {{kNow, "rsu_z", 100, 0, std::nullopt}, FixRejection::kUnknownRsu},
+      {{kNow, "rsu_a", nan, 0, std::nullopt}, FixRejection::kNonFinite},
+      {{kNow, "rsu_a", 100, kInfinity, std::nullopt}, FixRejection::kNonFinite},
+      {{kNow, "rsu_a", 100, 0, nan}, FixRejection::kNonFinite},
+      {{kNow, "rsu_a", 140, 0, std::nullopt}, FixRejection::kOutOfCoverage},
+      {{kNow - 2 * kNanosPerSecond, "rsu_a", 100, 0, std::nullopt}, FixRejection::kStale},
+      {{kNow + kNanosPerSecond, "rsu_a", 100, 0, std::nullopt}, FixRejection::kFromFuture},
+  };
+  for (const Case& k : cases) {
+    const FixVerdict v = c.check(k.fix, kNow);
+    EXPECT_EQ(v.rejection, k.reason) << v.detail;
+    EXPECT_NE(v.detail.find(toString(k.reason)), std::string::npos) << v.detail;
+    EXPECT_NE(v.detail.find(k.fix.rsu_id), std::string::npos) << v.detail;
+  }
+  EXPECT_TRUE(c.check({kNow - 1000, "rsu_a", 101, 0, std::nullopt}, kNow).accepted());
+  EXPECT_EQ(c.check({kNow - 1000, "rsu_a", 101, 0, std::nullopt}, kNow + 5).rejection, FixRejection::kDuplicate);
+  const FixCounters& a = c.counters().at("rsu_a");
+  EXPECT_EQ(a.non_finite, 3u);
+  EXPECT_EQ(a.out_of_coverage, 1u);
+  EXPECT_EQ(a.stale, 1u);
+  EXPECT_EQ(a.from_future, 1u);
+  EXPECT_EQ(a.duplicate, 1u);
+  EXPECT_EQ(a.accepted, 1u);
+  EXPECT_EQ(c.counters().at("rsu_z").unknown_rsu, 1u);
+}
+
+TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {
+  // Fixes at 10 Hz from a vehicle standing at (105, 1): one arrives 0.4 s late, one is lost. The
+  // filter applies the late one at its capture time: the result equals on-time delivery.
+  fusion::EkfConfig config;
+  config.auto_initialize = false;
+  auto run = [&](bool delayed) {
+    fusion::Localizer l(config);
+    l.addPoseSource("rsu_a");
+    PoseMeasurement start;
+    start.stamp = kNow;
+    start.pose.position = {104.5, 1.3, 0};
+    start.covariance = Matrix6d::Zero();
+    start.covariance.diagonal() << 0.5, 0.5, kInfinity, kInfinity, kInfinity, 0.1;
+    l.initialize(start);
+    FixChecker checker_local = checker();
+    for (int k = 1; k <= 30; ++k) {
+      const Stamp now = kNow + k * 20'000'000LL;
+      l.advanceTo(now);
+      if (k % 5 != 0 || k == 20) continue;  // 10 Hz; the fix of tick 20 is lost
+      if (delayed && k == 10) continue;  // held back by the link
+      const FixVerdict v = checker_local.check({now, "rsu_a", 105.0, 1.0, std::nullopt}, now);
+      EXPECT_TRUE(l.feedPose("rsu_a", v.measurement).applied());
+    }
+    if (delayed) {  // the fix of tick 10 arrives now, at tick 30
+      const FixVerdict v = checker_local.check({kNow + 10 * 20'000'000LL, "rsu_a", 105.0, 1.0, std::nullopt}, kNow + 30 * 20'000'000LL);
+      EXPECT_TRUE(v.accepted());
+      EXPECT_TRUE(l.feedPose("rsu_a", v.measurement).applied());
+    }
+    l.advanceTo(kNow + 40 * 20'000'000LL);
+    return l.estimate()->state;
+  };
+  const Vector6d on_time = run(false), late = run(true);
+  EXPECT_NEAR(on_time[0], 105.0, 0.05);
+  EXPECT_NEAR(on_time[1], 1.0, 0.05);
+  EXPECT_TRUE(on_time.isApprox(late, 1e-9) || (on_time - late).norm() < 1e-9);
+}
+
+}  // namespace
+}  // namespace coloc::rsu_client

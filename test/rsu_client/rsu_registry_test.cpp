@@ -1,0 +1,50 @@
+#include <gtest/gtest.h>
+
+#include "coloc/core/error.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+
+namespace coloc::rsu_client {
+namespace {
+
+void expectError(const std::string& yaml, const std::string& phrase) {
+  try {
+    RsuRegistry::parse(yaml, "rsu.yaml");
+    FAIL() << "expected an error containing '" << phrase << "'";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
+  }
+}
+
+TEST(RsuRegistry, ShippedRegistryLoadsWithThePublishedSigmas) {
+  const RsuRegistry r = RsuRegistry::load(COLOC_SOURCE_DIR "/config/rsu.yaml");
+  ASSERT_EQ(r.rsus().size(), 2u);
+  const RsuInfo* a = r.find("rsu_a");
+  ASSERT_NE(a, nullptr);
+  EXPECT_EQ(a->lidar.name, "VLP-16");
+  EXPECT_EQ(a->coverage_radius, 30.0);  // the model's effective range
+  EXPECT_EQ(r.variance(*a), 0.01486);   // the paper's placement: sigma on the diagonal
+  EXPECT_EQ(r.variance(*r.find("rsu_b")), 0.00681);
+  EXPECT_EQ(r.find("rsu_b")->coverage_radius, 50.0);
+}
+
+TEST(RsuRegistry, StandardDeviationPlacementSquaresTheSigma) {
+  const RsuRegistry r = RsuRegistry::parse(
+      "covariance_placement: standard_deviation\nrsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-32C}\n", "rsu.yaml");
+  EXPECT_DOUBLE_EQ(r.variance(*r.find("a")), 0.00681 * 0.00681);
+}
+
+TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: HDL-64}\n", "unknown LiDAR model 'HDL-64'");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16}\n  - {id: a, position: [1, 0], lidar_model: VLP-16}\n",
+              "'a' appears twice");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, colour: red}\n", "rsus[0].colour: unknown key");
+  expectError("rsus:\n  - {id: a, lidar_model: VLP-16}\n", "needs a position");
+  expectError("rsus:\n  - {id: a, position: [0], lidar_model: VLP-16}\n", "expected [x, y]");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, coverage_radius: -3}\n", "must be > 0");
+  expectError("rsus:\n  - {id: a/b, position: [0, 0], lidar_model: VLP-16}\n", "DDS topic");
+  expectError("covariance_placement: guessed\n", "expected published or standard_deviation");
+  expectError("rsu:\n  - {}\n", "rsu: unknown key");
+}
+
+}  // namespace
+}  // namespace coloc::rsu_client
