@@ -8,7 +8,7 @@ packages=(
   build-essential cmake pkg-config ccache
   libeigen3-dev
   libfastcdr-dev libfastrtps-dev fastddsgen
-  libsqlite3-dev libzstd-dev liblz4-dev libyaml-cpp-dev
+  libsqlite3-dev libzstd-dev liblz4-dev libyaml-cpp-dev openssl iproute2
   libcli11-dev nlohmann-json3-dev
   libpcl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
