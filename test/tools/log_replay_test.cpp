@@ -17,6 +17,13 @@ namespace {
 
 const std::string kNav2 = COLOC_SHARED_DATA_DIR "/rosbag2/nav2_turtlebot.mcap";
 
+io::TopicInfo topicOf(const std::string& name, const std::string& type) {
+  io::TopicInfo info;
+  info.name = name;
+  info.type = type;
+  return info;
+}
+
 const TopicUse& topic(const ReplayResult& r, const std::string& name) {
   for (const TopicUse& t : r.topics)
     if (t.topic == name) return t;
@@ -79,10 +86,10 @@ TEST(LogReplay, Sqlite3ConversionOfTheRecordingGivesTheSameFusedOutput) {
 std::string writeSyntheticLog(const testing::TempDir& dir) {
   const std::string path = dir / "drive";
   io::BagWriter bag = io::BagWriter::create(path);
-  bag.addTopic({"/ground_truth/odom", "nav_msgs/msg/Odometry"});
-  bag.addTopic({"/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"});
-  bag.addTopic({"/ndt_pose", "geometry_msgs/msg/PoseWithCovarianceStamped"});
-  bag.addTopic({"/chatter", "std_msgs/msg/String"});
+  bag.addTopic(topicOf("/ground_truth/odom", "nav_msgs/msg/Odometry"));
+  bag.addTopic(topicOf("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
+  bag.addTopic(topicOf("/ndt_pose", "geometry_msgs/msg/PoseWithCovarianceStamped"));
+  bag.addTopic(topicOf("/chatter", "std_msgs/msg/String"));
   const Stamp t0 = 1'700'000'000'000'000'000LL;
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.1);
@@ -189,7 +196,7 @@ TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   const Stamp t0 = 1'700'000'000'000'000'000LL;
   {
     io::BagWriter bag = io::BagWriter::create(dir / "scans");
-    bag.addTopic({"/points", "sensor_msgs/msg/PointCloud2"});
+    bag.addTopic(topicOf("/points", "sensor_msgs/msg/PointCloud2"));
     for (int i = 0; i < 3; ++i) {  // the same scan three times, 0.1 s apart, as a standing vehicle would see it
       const io::Bytes b = io::encodePointCloud2(toMessage(scan, t0 + i * 100'000'000LL));
       bag.write("/points", t0 + i * 100'000'000LL + 30'000'000LL, b.data(), b.size());
@@ -220,7 +227,7 @@ TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {
   testing::TempDir dir;
   {
     io::BagWriter bag = io::BagWriter::create(dir / "scans");
-    bag.addTopic({"/points", "sensor_msgs/msg/PointCloud2"});
+    bag.addTopic(topicOf("/points", "sensor_msgs/msg/PointCloud2"));
     ndt::PointCloud cloud;
     cloud.points = {{1, 2, 3}};
     const io::Bytes b = io::encodePointCloud2(toMessage(cloud, 1'000'000'000));
