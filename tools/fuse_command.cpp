@@ -63,6 +63,7 @@ nlohmann::ordered_json summaryJson(const std::string& log, const ReplayResult& r
     if (t.role != InputRole::kIgnore) {
       o["decode_errors"] = t.decode_errors;
       o["fallback_covariance"] = t.fallback_covariance;
+      o["link_dropped"] = t.link_dropped;
       o["delay_median_s"] = t.delay_median;
       o["delay_max_s"] = t.delay_max;
     }
@@ -114,6 +115,7 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     if (!t.note.empty()) std::printf("  (%s)", t.note.c_str());
     if (t.decode_errors) std::printf("  %llu undecodable", static_cast<unsigned long long>(t.decode_errors));
     if (t.fallback_covariance) std::printf("  %llu without covariance: fallback used", static_cast<unsigned long long>(t.fallback_covariance));
+    if (t.link_dropped) std::printf("  %llu lost on the emulated link", static_cast<unsigned long long>(t.link_dropped));
     std::printf("\n");
   }
   std::printf("\n  %-22s %8s %8s %7s %7s %7s %7s %8s %7s\n", "source", "received", "applied", "gated", "too_old", "future",

@@ -104,6 +104,42 @@ Vector6d readVariances(const Context& ctx, const YAML::Node& node, const std::st
   return v;
 }
 
+rsu_client::LinkConfig readLink(const Context& ctx, const YAML::Node& node, const std::string& where) {
+  requireMap(ctx, node, where);
+  rsu_client::LinkConfig link;
+  auto probability = [&](const YAML::Node& n, const std::string& key) {
+    const double v = ctx.readDouble(n, key);
+    if (!(v >= 0.0 && v <= 1.0)) ctx.fail(n, key, "must be a probability in [0, 1]");
+    return v;
+  };
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const std::string full = where + "." + key;
+    if (key == "delay" || key == "jitter") {
+      const double v = ctx.readDouble(entry.second, full);
+      if (!(v >= 0.0 && v < 10.0)) ctx.fail(entry.second, full, "must be in [0, 10) s");
+      (key == "delay" ? link.delay : link.jitter) = v;
+    } else if (key == "loss") {
+      link.loss = probability(entry.second, full);
+    } else if (key == "burst") {
+      link.burst = ctx.read<bool>(entry.second, full, "true or false");
+    } else if (key == "p_good_to_bad") {
+      link.p_good_to_bad = probability(entry.second, full);
+    } else if (key == "p_bad_to_good") {
+      link.p_bad_to_good = probability(entry.second, full);
+    } else if (key == "loss_in_good") {
+      link.loss_in_good = probability(entry.second, full);
+    } else if (key == "loss_in_bad") {
+      link.loss_in_bad = probability(entry.second, full);
+    } else if (key == "seed") {
+      link.seed = ctx.read<std::uint64_t>(entry.second, full, "a non-negative integer");
+    } else {
+      ctx.fail(entry.first, full, "unknown key (delay, jitter, loss, burst, p_good_to_bad, p_bad_to_good, loss_in_good, loss_in_bad, seed)");
+    }
+  }
+  return link;
+}
+
 InputConfig readInput(const Context& ctx, const std::string& topic, const YAML::Node& node) {
   const std::string where = "inputs." + topic;
   requireMap(ctx, node, where);
@@ -128,8 +164,10 @@ InputConfig readInput(const Context& ctx, const std::string& topic, const YAML::
     } else if (key == "additional_delay") {
       input.additional_delay = ctx.readDouble(entry.second, full);
       if (!(input.additional_delay >= 0.0 && input.additional_delay < 10.0)) ctx.fail(entry.second, full, "must be in [0, 10) s");
+    } else if (key == "link") {
+      input.link = readLink(ctx, entry.second, full);
     } else {
-      ctx.fail(entry.first, full, "unknown key (role, source, covariance_diagonal, additional_delay)");
+      ctx.fail(entry.first, full, "unknown key (role, source, covariance_diagonal, additional_delay, link)");
     }
   }
   if (!has_role) ctx.fail(node, where, "needs a role: pose, twist, ground_truth, scan or ignore");
@@ -399,7 +437,7 @@ std::string defaultConfigYaml() {
          "# Example:\n"
          "#   /amcl_pose: {role: pose, source: amcl}\n"
          "#   /odom: {role: twist, covariance_diagonal: [0.01, .inf, .inf, .inf, .inf, 0.0025]}\n"
-         "#   /rsu/fix: {role: pose, additional_delay: 0.01}\n"
+         "#   /rsu/rsu_a/fix: {role: pose, link: {delay: 0.03, jitter: 0.005, loss: 0.2, seed: 1}}\n"
          "inputs: {}\n\nreplay:\n";
   for (const auto& k : replayKeys()) {
     out << "  # " << k.meaning;
@@ -421,7 +459,9 @@ std::string configReferenceMarkdown() {
   out << "| `inputs.TOPIC.role` | by type | | `pose`, `twist`, `ground_truth`, `scan` (PointCloud2 for NDT) or `ignore` |\n"
          "| `inputs.TOPIC.source` | the topic | | the source's name in the filter and the summary |\n"
          "| `inputs.TOPIC.covariance_diagonal` | from the message | variances | 6 values replacing the message's covariance; `.inf` = not measured |\n"
-         "| `inputs.TOPIC.additional_delay` | `0` | s | the data was sensed this long before its stamp |\n";
+         "| `inputs.TOPIC.additional_delay` | `0` | s | the data was sensed this long before its stamp |\n"
+         "| `inputs.TOPIC.link` | none | | replay the topic through an emulated link: `{delay, jitter, loss, burst, p_good_to_bad, "
+         "p_bad_to_good, loss_in_good, loss_in_bad, seed}` (s, probabilities); deterministic |\n";
   for (const auto& k : replayKeys())
     out << "| `replay." << k.key << "` | `" << k.value(defaults.replay) << "` | " << k.unit << " | " << k.meaning << " |\n";
   return out.str();

@@ -10,6 +10,7 @@
 #include "coloc/core/types.hpp"
 #include "coloc/fusion/ekf_config.hpp"
 #include "coloc/ndt/ndt_pose_source.hpp"
+#include "coloc/rsu_client/link_emulator.hpp"
 
 namespace coloc::tools {
 
@@ -22,6 +23,8 @@ struct InputConfig {
   std::string source;                      ///< name in the Localizer; default: the topic
   std::optional<Vector6d> covariance_diagonal;  ///< replaces the message's covariance
   double additional_delay = 0.0;           ///< s; the data was sensed this much before its stamp
+  /// Replays the topic through an emulated radio link (delay, jitter, loss), as experiments do.
+  std::optional<rsu_client::LinkConfig> link;
 };
 
 enum class ClockMode { kAuto, kSame, kSeparate };

@@ -251,10 +251,31 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     for (const Event& e : events) samples.push_back({e.log_time, e.stamp});
     result.clock_fit = fitClock(samples);
   }
-  for (Event& e : events) {
+  for (Event& e : events)
     e.arrival = result.clock == ClockMode::kSeparate ? std::max(result.clock_fit.toStampClock(e.log_time), e.stamp) : e.log_time;
-    delays[e.topic].push_back(toSeconds(e.arrival - e.stamp));
+  // Topics replayed through an emulated link: each message, in recorded order, is delayed or lost.
+  std::map<std::size_t, rsu_client::LinkEmulator> links;
+  for (std::size_t i = 0; i < result.topics.size(); ++i)
+    if (result.topics[i].from_config && config.inputs.at(result.topics[i].topic).link)
+      links.emplace(i, rsu_client::LinkEmulator(*config.inputs.at(result.topics[i].topic).link));
+  if (!links.empty()) {
+    std::vector<Event> kept;
+    kept.reserve(events.size());
+    for (Event& e : events) {
+      const auto link = links.find(e.topic);
+      if (link != links.end()) {
+        const std::optional<Stamp> delivered = link->second.transmit(e.arrival);
+        if (!delivered) {
+          ++result.topics[e.topic].link_dropped;
+          continue;
+        }
+        e.arrival = *delivered;
+      }
+      kept.push_back(std::move(e));
+    }
+    events = std::move(kept);
   }
+  for (const Event& e : events) delays[e.topic].push_back(toSeconds(e.arrival - e.stamp));
   for (std::size_t i = 0; i < delays.size(); ++i) {
     if (delays[i].empty()) continue;
     result.topics[i].delay_median = median(delays[i]);

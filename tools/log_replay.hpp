@@ -27,6 +27,7 @@ struct TopicUse {
   std::uint64_t messages = 0;
   std::uint64_t decode_errors = 0;
   std::uint64_t fallback_covariance = 0;  ///< messages that carried no covariance
+  std::uint64_t link_dropped = 0;         ///< lost on the emulated link (inputs.TOPIC.link)
   std::string first_error;
   // Delay = arrival - stamp on the stamp clock, over the decoded messages.
   double delay_median = 0.0, delay_max = 0.0;  ///< s

@@ -152,6 +152,23 @@ TEST(LogReplay, SyntheticDriveIsFusedAndScoredAgainstItsGroundTruth) {
   EXPECT_LT(mean, 0.08);
 }
 
+TEST(LogReplay, TopicReplayedThroughAnEmulatedLinkIsDelayedAndThinnedRepeatably) {
+  testing::TempDir dir;
+  const std::string log = writeSyntheticLog(dir);
+  ReplayOptions options;
+  options.config = parseFuseConfig(
+      "inputs:\n  /ndt_pose: {role: pose, link: {delay: 0.05, jitter: 0.0, loss: 0.3, seed: 5}}\n", "test.yaml");
+  const ReplayResult a = replayLog(log, options), b = replayLog(log, options);
+  const TopicUse& pose = topic(a, "/ndt_pose");
+  EXPECT_GT(pose.link_dropped, 10u);
+  EXPECT_LT(pose.link_dropped, 50u);
+  EXPECT_NEAR(pose.delay_median, 0.150, 1e-6);  // 100 ms recorded + 50 ms emulated
+  EXPECT_EQ(counters(a, "/ndt_pose").applied + pose.link_dropped, 100u);  // 101 written, one undecodable
+  EXPECT_EQ(topic(b, "/ndt_pose").link_dropped, pose.link_dropped);
+  ASSERT_EQ(a.fused.size(), b.fused.size());
+  EXPECT_EQ(a.fused.back().pose.position, b.fused.back().pose.position);
+}
+
 TEST(LogReplay, ConfiguredRoleOnAnIncompatibleTypeIsAnErrorNamingTheTopic) {
   testing::TempDir dir;
   ReplayOptions options;
