@@ -1,0 +1,44 @@
+#pragma once
+// Velodyne LiDARs as the twist simulates them: real vertical angle tables, 10 Hz rotation with 0.2 deg
+// azimuth steps, each point stamped with its time in the sweep, Gaussian range noise, range limits.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "coloc/sim/ray_caster.hpp"
+
+namespace coloc::sim {
+
+struct LidarSpec {
+  std::string name;
+  std::vector<double> vertical_deg;       ///< per laser
+  std::vector<double> azimuth_offset_deg; ///< per laser (rot_correction)
+  double rotation_hz = 10.0;
+  double azimuth_step_deg = 0.2;
+  double range_noise = 0.02;  ///< m, standard deviation
+  double min_range = 0.9;     ///< m
+  double max_range = 100.0;   ///< m
+};
+
+/// Velodyne's published calibration (ros-drivers/velodyne VLP16db.yaml, VeloView-VLP-32C.yaml).
+LidarSpec vlp16();
+LidarSpec vlp32c();
+
+struct LidarPoint {
+  Eigen::Vector3f position;  ///< sensor frame at the time of its firing
+  float time;                ///< s since the start of the sweep
+  int laser;
+  int mesh;                  ///< what the ray hit (ground truth only)
+};
+
+/// The sensor's pose in the world at time t since the start of the sweep.
+using SensorTrajectory = std::function<Eigen::Isometry3d(double t)>;
+
+/// One revolution. Each firing is cast from where the sensor is at its own time, so a moving sensor's
+/// scan carries the motion distortion a real one has. Noise is drawn from `rng`.
+std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng);
+
+}  // namespace coloc::sim

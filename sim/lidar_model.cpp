@@ -1,0 +1,67 @@
+#include "coloc/sim/lidar_model.hpp"
+
+#include <cmath>
+
+namespace coloc::sim {
+
+LidarSpec vlp16() {
+  LidarSpec s;
+  s.name = "VLP-16";
+  s.vertical_deg = {-15, 1, -13, 3, -11, 5, -9, 7, -7, 9, -5, 11, -3, 13, -1, 15};
+  s.azimuth_offset_deg.assign(16, 0.0);
+  s.max_range = 100.0;
+  return s;
+}
+
+LidarSpec vlp32c() {
+  LidarSpec s;
+  s.name = "VLP-32C";
+  s.vertical_deg = {-25.0, -1.0,  -1.667, -15.639, -11.31, 0.0,    -0.667, -8.843, -7.254, 0.333, -0.333,
+                    -6.148, -5.333, 1.333, 0.667,   -4.0,   -4.667, 1.667,  1.0,    -3.667, -3.333, 3.333,
+                    2.333,  -2.667, -3.0,  7.0,     4.667,  -2.333, -2.0,   15.0,   10.333, -1.333};
+  s.azimuth_offset_deg = {-1.4, 4.2, -1.4, 1.4, -1.4, 1.4, -4.2, 1.4, -1.4, 4.2, -1.4, 1.4, -4.2, 1.4, -4.2, 1.4,
+                          -1.4, 4.2, -1.4, 4.2, -4.2, 1.4, -1.4, 1.4, -1.4, 1.4, -1.4, 4.2, -4.2, 1.4, -1.4, 1.4};
+  s.max_range = 200.0;
+  return s;
+}
+
+std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng) {
+  const int lasers = static_cast<int>(spec.vertical_deg.size());
+  const int firings = static_cast<int>(std::lround(360.0 / spec.azimuth_step_deg));
+  const double sweep = 1.0 / spec.rotation_hz;
+  std::vector<Eigen::Vector3f> origins, directions, local_directions;
+  std::vector<float> times;
+  std::vector<int> laser_of;
+  origins.reserve(static_cast<std::size_t>(firings * lasers));
+  directions.reserve(origins.capacity());
+  for (int f = 0; f < firings; ++f) {
+    const double t = sweep * f / firings;
+    const Eigen::Isometry3d sensor = pose(t);
+    const double azimuth = spec.azimuth_step_deg * f;
+    for (int l = 0; l < lasers; ++l) {
+      const double a = (azimuth + spec.azimuth_offset_deg[l]) * M_PI / 180.0, e = spec.vertical_deg[l] * M_PI / 180.0;
+      const Eigen::Vector3d local(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+      origins.push_back(sensor.translation().cast<float>());
+      directions.push_back((sensor.linear() * local).normalized().cast<float>());
+      local_directions.push_back(local.cast<float>());
+      times.push_back(static_cast<float>(t));
+      laser_of.push_back(l);
+    }
+  }
+  std::vector<RayHit> hits;
+  world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
+  std::normal_distribution<double> noise(0.0, spec.range_noise);
+  std::vector<LidarPoint> points;
+  points.reserve(hits.size() / 2);
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    // One noise draw per ray, hit or not, so that the noise of a point does not depend on the others.
+    const double n = noise(rng);
+    if (hits[i].distance < 0.0f) continue;
+    const double range = hits[i].distance + n;
+    if (range < spec.min_range || range > spec.max_range) continue;
+    points.push_back({static_cast<float>(range) * local_directions[i], times[i], laser_of[i], hits[i].mesh});
+  }
+  return points;
+}
+
+}  // namespace coloc::sim

@@ -1,0 +1,58 @@
+#include "coloc/sim/mesh.hpp"
+
+#include <cmath>
+
+namespace coloc::sim {
+
+void TriangleMesh::append(const TriangleMesh& other) {
+  const int offset = static_cast<int>(vertices.size());
+  vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
+  for (const Eigen::Vector3i& t : other.triangles) triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+}
+
+TriangleMesh groundRectangle(const Eigen::Vector2f& min, const Eigen::Vector2f& max, float z) {
+  TriangleMesh m;
+  m.vertices = {{min.x(), min.y(), z}, {max.x(), min.y(), z}, {max.x(), max.y(), z}, {min.x(), max.y(), z}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+TriangleMesh box(const Eigen::Vector3f& base, const Eigen::Vector3f& size, float yaw) {
+  const float hx = 0.5f * size.x(), hy = 0.5f * size.y(), h = size.z();
+  TriangleMesh m;
+  for (int k = 0; k < 2; ++k) {
+    const float z = k * h;
+    m.vertices.insert(m.vertices.end(), {{-hx, -hy, z}, {hx, -hy, z}, {hx, hy, z}, {-hx, hy, z}});
+  }
+  // bottom, top, then the four sides
+  m.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                 {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  return transformed(m, base, yaw);
+}
+
+TriangleMesh cylinder(const Eigen::Vector3f& base, float radius, float height, int sides) {
+  TriangleMesh m;
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < sides; ++i) {
+      const float a = 2.0f * static_cast<float>(M_PI) * i / sides;
+      m.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), k * height);
+    }
+  m.vertices.emplace_back(0.0f, 0.0f, height);  // top centre
+  const int top = 2 * sides;
+  for (int i = 0; i < sides; ++i) {
+    const int j = (i + 1) % sides;
+    m.triangles.emplace_back(i, j, sides + j);
+    m.triangles.emplace_back(i, sides + j, sides + i);
+    m.triangles.emplace_back(sides + i, sides + j, top);
+  }
+  return transformed(m, base, 0.0f);
+}
+
+TriangleMesh transformed(const TriangleMesh& mesh, const Eigen::Vector3f& translation, float yaw) {
+  TriangleMesh out = mesh;
+  const float c = std::cos(yaw), s = std::sin(yaw);
+  for (Eigen::Vector3f& v : out.vertices) v = Eigen::Vector3f(c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()) + translation;
+  return out;
+}
+
+}  // namespace coloc::sim
