@@ -1,0 +1,48 @@
+#pragma once
+// L-shape fitting of a vehicle's points seen from one side (Zhang, Xu, Dong, Dolan, IEEE IV 2017), and
+// the paper's refinement: a box of the vehicle's true size, sent in its CAM, aligned to the fitted corner
+// closest to the LiDAR (the "alignment point"), which is the corner the LiDAR sees best.
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace coloc::sim {
+
+enum class LShapeCriterion {
+  kArea,       ///< smallest rectangle: biased towards the diagonal when one L is seen (kept for comparison)
+  kCloseness,  ///< points close to the two nearest edges
+  kVariance,   ///< small spread of the distances to the nearest edges
+};
+
+struct LShapeConfig {
+  LShapeCriterion criterion = LShapeCriterion::kVariance;
+  double angle_step_deg = 1.0;    ///< search resolution over [0, 90] deg, both ends included
+  double closeness_floor = 0.01;  ///< m, d0 of the closeness criterion
+};
+
+struct FittedRectangle {
+  std::array<Eigen::Vector2d, 4> corners;  ///< in order around the rectangle
+  double angle = 0.0;                      ///< rad in [0, pi/2]: direction of the first edge
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+};
+
+/// Needs at least 2 points; throws coloc::Error otherwise.
+FittedRectangle fitLShape(const std::vector<Eigen::Vector2d>& points, const LShapeConfig& config = {});
+
+struct AlignedBox {
+  Eigen::Vector2d center;           ///< centre of the true-size box
+  double yaw;                       ///< heading of its length axis, resolved with the prior
+  Eigen::Vector2d alignment_point;  ///< the fitted corner closest to the LiDAR
+};
+
+/// Places a box of `length` x `width` on the alignment point and extends it along the rectangle's edges
+/// from there. The alignment point is the paper's: the fitted corner closest to `lidar` (x-y), taken
+/// among the corners where both adjacent edges carry points. When the far part of a face is not seen,
+/// the fitted rectangle shrinks towards the LiDAR and a corner that no face reaches can come nearest;
+/// the corner where the two seen faces meet is the one the LiDAR really saw. Which edge carries the
+/// length, and which way the vehicle faces, come from `heading_prior` (the vehicle's or the road's
+/// direction), since a rectangle alone cannot tell.
+AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& lidar,
+                            double length, double width, double heading_prior);
+
+}  // namespace coloc::sim
