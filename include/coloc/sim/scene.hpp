@@ -1,0 +1,52 @@
+#pragma once
+// A digital-twin scenario from YAML: the world's objects as meshes (ground, buildings, walls, poles,
+// trees, parked cars), which of them the survey map has (a map can be older than the world), the ego
+// vehicle's route and speed, and the roadside units.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "coloc/sim/mesh.hpp"
+#include "coloc/sim/vehicle_motion.hpp"
+
+namespace coloc::sim {
+
+struct SceneObject {
+  std::string type;       ///< building, wall, pole, tree, parked_car
+  TriangleMesh mesh;
+  bool in_world = true;   ///< false: removed since the survey (the map still has it)
+  bool in_map = true;     ///< false: added since the survey (the map lacks it)
+};
+
+struct ScenarioRsu {
+  std::string id;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  double height = 2.0;
+  double yaw = 0.0;
+  std::string lidar_model = "VLP-16";
+};
+
+struct Scenario {
+  std::string name;
+  std::uint64_t seed = 1;
+  Eigen::Vector2d ground_min = Eigen::Vector2d(-50, -50), ground_max = Eigen::Vector2d(50, 50);
+  std::vector<SceneObject> objects;
+  Eigen::Vector2d route_start = Eigen::Vector2d::Zero();
+  double route_heading = 0.0;
+  std::vector<RoutePiece> route;
+  SpeedProfile speed;
+  std::string vehicle_lidar = "VLP-32C";
+  double vehicle_lidar_height = 1.9;  ///< m above the road
+  std::vector<ScenarioRsu> rsus;
+
+  /// The meshes of the world (ground first) or of the world as surveyed.
+  std::vector<TriangleMesh> worldMeshes() const;
+  std::vector<TriangleMesh> mapMeshes() const;
+};
+
+/// Throws coloc::Error naming the file, line and key for unknown keys, unknown object types or LiDAR
+/// models, and values out of range.
+Scenario loadScenario(const std::string& path);
+Scenario parseScenario(const std::string& yaml_text, const std::string& source_name);
+
+}  // namespace coloc::sim

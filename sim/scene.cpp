@@ -1,0 +1,220 @@
+#include "coloc/sim/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "coloc/core/error.hpp"
+#include "coloc/sim/vehicle_body.hpp"
+
+namespace coloc::sim {
+
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& why) const {
+    std::ostringstream out;
+    out << source_;
+    if (n.Mark().line >= 0) out << ":" << n.Mark().line + 1;
+    out << ": " << key << ": " << why;
+    throw Error(out.str());
+  }
+  double number(const YAML::Node& n, const std::string& key) const {
+    try {
+      const double v = n.as<double>();
+      if (!std::isfinite(v)) fail(n, key, "must be finite");
+      return v;
+    } catch (const YAML::Exception&) {
+      fail(n, key, "expected a number");
+    }
+  }
+  double positive(const YAML::Node& n, const std::string& key) const {
+    const double v = number(n, key);
+    if (v <= 0.0) fail(n, key, "must be > 0");
+    return v;
+  }
+  Eigen::Vector2d vec2(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 2) fail(n, key, "expected [x, y]");
+    return {number(n[0], key), number(n[1], key)};
+  }
+  Eigen::Vector3d vec3(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 3) fail(n, key, "expected [x, y, z]");
+    return {number(n[0], key), number(n[1], key), number(n[2], key)};
+  }
+  std::string text(const YAML::Node& n, const std::string& key) const {
+    try {
+      return n.as<std::string>();
+    } catch (const YAML::Exception&) {
+      fail(n, key, "expected a string");
+    }
+  }
+  bool flag(const YAML::Node& n, const std::string& key) const {
+    try {
+      return n.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(n, key, "expected true or false");
+    }
+  }
+  void keys(const YAML::Node& n, const std::string& where, std::initializer_list<const char*> allowed) const {
+    if (!n.IsMap()) fail(n, where, "expected a mapping");
+    for (const auto& e : n) {
+      const std::string k = e.first.as<std::string>();
+      bool ok = false;
+      std::string list;
+      for (const char* a : allowed) {
+        ok = ok || k == a;
+        list += std::string(list.empty() ? "" : ", ") + a;
+      }
+      if (!ok) fail(e.first, where + "." + k, "unknown key (" + list + ")");
+    }
+  }
+  const YAML::Node require(const YAML::Node& n, const char* key, const std::string& where) const {
+    if (!n[key]) fail(n, where, std::string("needs ") + key);
+    return n[key];
+  }
+
+ private:
+  std::string source_;
+};
+
+SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& where) {
+  SceneObject o;
+  o.type = r.text(r.require(n, "type", where), where + ".type");
+  const auto common = [&](const YAML::Node& node) {
+    if (node["in_world"]) o.in_world = r.flag(node["in_world"], where + ".in_world");
+    if (node["in_map"]) o.in_map = r.flag(node["in_map"], where + ".in_map");
+    if (!o.in_world && !o.in_map) r.fail(node, where, "an object in neither the world nor the map");
+  };
+  if (o.type == "building") {
+    r.keys(n, where, {"type", "center", "size", "yaw", "in_world", "in_map"});
+    const Eigen::Vector2d c = r.vec2(r.require(n, "center", where), where + ".center");
+    const Eigen::Vector3d s = r.vec3(r.require(n, "size", where), where + ".size");
+    const double yaw = n["yaw"] ? r.number(n["yaw"], where + ".yaw") : 0.0;
+    o.mesh = box(Eigen::Vector3f(static_cast<float>(c.x()), static_cast<float>(c.y()), 0.0f), s.cast<float>(), static_cast<float>(yaw));
+  } else if (o.type == "wall") {
+    r.keys(n, where, {"type", "from", "to", "height", "thickness", "in_world", "in_map"});
+    const Eigen::Vector2d a = r.vec2(r.require(n, "from", where), where + ".from"), b = r.vec2(r.require(n, "to", where), where + ".to");
+    const double h = r.positive(r.require(n, "height", where), where + ".height");
+    const double t = n["thickness"] ? r.positive(n["thickness"], where + ".thickness") : 0.3;
+    const Eigen::Vector2d mid = 0.5 * (a + b);
+    o.mesh = box(Eigen::Vector3f(static_cast<float>(mid.x()), static_cast<float>(mid.y()), 0.0f),
+                 Eigen::Vector3f(static_cast<float>((b - a).norm()), static_cast<float>(t), static_cast<float>(h)),
+                 static_cast<float>(std::atan2(b.y() - a.y(), b.x() - a.x())));
+  } else if (o.type == "pole") {
+    r.keys(n, where, {"type", "at", "radius", "height", "in_world", "in_map"});
+    const Eigen::Vector2d p = r.vec2(r.require(n, "at", where), where + ".at");
+    o.mesh = cylinder(Eigen::Vector3f(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.0f),
+                      static_cast<float>(n["radius"] ? r.positive(n["radius"], where + ".radius") : 0.15),
+                      static_cast<float>(r.positive(r.require(n, "height", where), where + ".height")));
+  } else if (o.type == "tree") {
+    r.keys(n, where, {"type", "at", "height", "crown", "in_world", "in_map"});
+    const Eigen::Vector2d p = r.vec2(r.require(n, "at", where), where + ".at");
+    const float h = static_cast<float>(r.positive(r.require(n, "height", where), where + ".height"));
+    const float crown = static_cast<float>(n["crown"] ? r.positive(n["crown"], where + ".crown") : 2.0);
+    const Eigen::Vector3f base(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.0f);
+    o.mesh = cylinder(base, 0.2f, 0.5f * h);
+    o.mesh.append(cylinder(base + Eigen::Vector3f(0, 0, 0.5f * h), 0.5f * crown, 0.5f * h, 8));
+  } else if (o.type == "parked_car") {
+    r.keys(n, where, {"type", "at", "yaw", "in_world", "in_map"});
+    const Eigen::Vector2d p = r.vec2(r.require(n, "at", where), where + ".at");
+    o.mesh = VehicleBody{}.mesh(p.x(), p.y(), n["yaw"] ? r.number(n["yaw"], where + ".yaw") : 0.0);
+  } else {
+    r.fail(n["type"], where + ".type", "unknown object type '" + o.type + "' (building, wall, pole, tree, parked_car)");
+  }
+  common(n);
+  return o;
+}
+
+}  // namespace
+
+Scenario parseScenario(const std::string& yaml_text, const std::string& source) {
+  const Reader r(source);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw Error(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+  r.keys(root, "(top level)", {"name", "seed", "ground", "objects", "route", "vehicle", "rsus"});
+  Scenario s;
+  s.name = root["name"] ? r.text(root["name"], "name") : "scenario";
+  if (root["seed"]) s.seed = root["seed"].as<std::uint64_t>();
+  if (root["ground"]) {
+    r.keys(root["ground"], "ground", {"min", "max"});
+    s.ground_min = r.vec2(r.require(root["ground"], "min", "ground"), "ground.min");
+    s.ground_max = r.vec2(r.require(root["ground"], "max", "ground"), "ground.max");
+    if ((s.ground_max.array() <= s.ground_min.array()).any()) r.fail(root["ground"], "ground", "max must exceed min");
+  }
+  if (root["objects"]) {
+    if (!root["objects"].IsSequence()) r.fail(root["objects"], "objects", "expected a list");
+    for (std::size_t i = 0; i < root["objects"].size(); ++i)
+      s.objects.push_back(readObject(r, root["objects"][i], "objects[" + std::to_string(i) + "]"));
+  }
+  const YAML::Node route = r.require(root, "route", "(top level)");
+  r.keys(route, "route", {"start", "heading", "pieces", "speed", "acceleration"});
+  s.route_start = r.vec2(r.require(route, "start", "route"), "route.start");
+  s.route_heading = route["heading"] ? r.number(route["heading"], "route.heading") : 0.0;
+  const YAML::Node pieces = r.require(route, "pieces", "route");
+  if (!pieces.IsSequence() || pieces.size() == 0) r.fail(pieces, "route.pieces", "expected a list of {length, curvature}");
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    const std::string where = "route.pieces[" + std::to_string(i) + "]";
+    r.keys(pieces[i], where, {"length", "curvature"});
+    s.route.push_back({r.positive(r.require(pieces[i], "length", where), where + ".length"),
+                       pieces[i]["curvature"] ? r.number(pieces[i]["curvature"], where + ".curvature") : 0.0});
+  }
+  if (route["speed"]) s.speed.cruise = r.positive(route["speed"], "route.speed");
+  if (route["acceleration"]) s.speed.acceleration = r.positive(route["acceleration"], "route.acceleration");
+  if (root["vehicle"]) {
+    r.keys(root["vehicle"], "vehicle", {"lidar", "lidar_height"});
+    if (root["vehicle"]["lidar"]) s.vehicle_lidar = r.text(root["vehicle"]["lidar"], "vehicle.lidar");
+    if (s.vehicle_lidar != "VLP-16" && s.vehicle_lidar != "VLP-32C")
+      r.fail(root["vehicle"]["lidar"], "vehicle.lidar", "unknown LiDAR model '" + s.vehicle_lidar + "' (VLP-16, VLP-32C)");
+    if (root["vehicle"]["lidar_height"]) s.vehicle_lidar_height = r.positive(root["vehicle"]["lidar_height"], "vehicle.lidar_height");
+  }
+  if (root["rsus"]) {
+    for (std::size_t i = 0; i < root["rsus"].size(); ++i) {
+      const YAML::Node n = root["rsus"][i];
+      const std::string where = "rsus[" + std::to_string(i) + "]";
+      r.keys(n, where, {"id", "position", "height", "yaw", "lidar_model"});
+      ScenarioRsu rsu;
+      rsu.id = r.text(r.require(n, "id", where), where + ".id");
+      rsu.position = r.vec2(r.require(n, "position", where), where + ".position");
+      if (n["height"]) rsu.height = r.positive(n["height"], where + ".height");
+      if (n["yaw"]) rsu.yaw = r.number(n["yaw"], where + ".yaw");
+      if (n["lidar_model"]) rsu.lidar_model = r.text(n["lidar_model"], where + ".lidar_model");
+      if (rsu.lidar_model != "VLP-16" && rsu.lidar_model != "VLP-32C")
+        r.fail(n["lidar_model"], where + ".lidar_model", "unknown LiDAR model '" + rsu.lidar_model + "' (VLP-16, VLP-32C)");
+      s.rsus.push_back(rsu);
+    }
+  }
+  Route(s.route_start, s.route_heading, s.route);  // validates the pieces
+  return s;
+}
+
+Scenario loadScenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the scenario");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseScenario(text.str(), path);
+}
+
+std::vector<TriangleMesh> Scenario::worldMeshes() const {
+  std::vector<TriangleMesh> out = {groundRectangle(ground_min.cast<float>(), ground_max.cast<float>())};
+  for (const SceneObject& o : objects)
+    if (o.in_world) out.push_back(o.mesh);
+  return out;
+}
+
+std::vector<TriangleMesh> Scenario::mapMeshes() const {
+  std::vector<TriangleMesh> out = {groundRectangle(ground_min.cast<float>(), ground_max.cast<float>())};
+  for (const SceneObject& o : objects)
+    if (o.in_map) out.push_back(o.mesh);
+  return out;
+}
+
+}  // namespace coloc::sim
