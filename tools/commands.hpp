@@ -10,5 +10,6 @@ void addConfigCommand(CLI::App& app);
 void addAlignCommand(CLI::App& app);
 void addRsuListenCommand(CLI::App& app);
 void addRsuPublishCommand(CLI::App& app);
+void addSimulateCommand(CLI::App& app);
 
 }  // namespace coloc::tools

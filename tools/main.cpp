@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   coloc::tools::addAlignCommand(app);
   coloc::tools::addRsuListenCommand(app);
   coloc::tools::addRsuPublishCommand(app);
+  coloc::tools::addSimulateCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
