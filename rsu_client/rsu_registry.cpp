@@ -7,7 +7,7 @@
 #include <set>
 #include <sstream>
 
-#include "coloc/core/error.hpp"
+#include "coloc/core/config_error.hpp"
 
 namespace coloc::rsu_client {
 
@@ -26,11 +26,7 @@ const LidarModel* findLidarModel(const std::string& name) {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const YAML::Node& node, const std::string& key, const std::string& why) {
-  std::ostringstream out;
-  out << source;
-  if (node.Mark().line >= 0) out << ":" << node.Mark().line + 1;
-  out << ": " << key << ": " << why;
-  throw Error(out.str());
+  throwConfigError(source, node.Mark().line, key, why);
 }
 
 double number(const std::string& source, const YAML::Node& node, const std::string& key) {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "coloc/core/error.hpp"
+#include "coloc/core/config_error.hpp"
 #include "coloc/sim/vehicle_body.hpp"
 
 namespace coloc::sim {
@@ -17,11 +17,7 @@ class Reader {
  public:
   explicit Reader(std::string source) : source_(std::move(source)) {}
   [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& why) const {
-    std::ostringstream out;
-    out << source_;
-    if (n.Mark().line >= 0) out << ":" << n.Mark().line + 1;
-    out << ": " << key << ": " << why;
-    throw Error(out.str());
+    throwConfigError(source_, n.Mark().line, key, why);
   }
   double number(const YAML::Node& n, const std::string& key) const {
     try {

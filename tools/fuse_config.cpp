@@ -8,7 +8,7 @@
 #include <type_traits>
 #include <sstream>
 
-#include "coloc/core/error.hpp"
+#include "coloc/core/config_error.hpp"
 #include "coloc/fusion/ekf_params.hpp"
 #include "coloc/fusion/localizer.hpp"
 
@@ -41,11 +41,7 @@ class Context {
  public:
   explicit Context(std::string source) : source_(std::move(source)) {}
   [[noreturn]] void fail(const YAML::Node& node, const std::string& key, const std::string& why) const {
-    std::ostringstream out;
-    out << source_;
-    if (node.Mark().line >= 0) out << ":" << node.Mark().line + 1;
-    out << ": " << key << ": " << why;
-    throw Error(out.str());
+    throwConfigError(source_, node.Mark().line, key, why);
   }
   template <typename T>
   T read(const YAML::Node& node, const std::string& key, const char* what) const {
