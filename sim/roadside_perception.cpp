@@ -99,20 +99,18 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     foreground.emplace_back(xy.x(), xy.y(), height);
   }
   out.foreground_points = foreground.size();
-  // 2. The cluster nearest the expected position is the vehicle.
   const auto groups = clusters(foreground, c.cluster_distance);
-  const std::vector<std::size_t>* vehicle = nullptr;
-  double best = INFINITY;
+  // 2. The vehicle is every cluster that reaches into its footprint around the expected position. A
+  //    body seen from afar falls apart into pieces (bumper, cabin, side) farther apart than any linkage
+  //    distance that still separates it from its neighbours; its size, known from the CAM, joins them.
+  const double reach = 0.5 * std::hypot(length, width) + 1.0;
+  std::vector<std::size_t> vehicle_points;
   for (const auto& g : groups) {
-    if (g.size() < 5) continue;
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    for (std::size_t i : g) mean += foreground[i].head<2>();
-    const double d = (mean / static_cast<double>(g.size()) - reference).norm();
-    if (d < best) {
-      best = d;
-      vehicle = &g;
-    }
+    bool near = false;
+    for (std::size_t i : g) near = near || (foreground[i].head<2>() - reference).norm() <= reach;
+    if (near) vehicle_points.insert(vehicle_points.end(), g.begin(), g.end());
   }
+  const std::vector<std::size_t>* vehicle = vehicle_points.size() >= 5 ? &vehicle_points : nullptr;
   if (vehicle) {
     // 3. The lowest part of the body: below the cut, at most max_points, lowest first.
     std::vector<Eigen::Vector3d> body;
