@@ -7,6 +7,8 @@
 //   build/bench/ekf_bench --benchmark_filter=/50   # window 50 only
 #include <benchmark/benchmark.h>
 
+#include "median_collector.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -127,18 +129,6 @@ void windowsAndPhases(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_Coloc)->Apply(windowsAndPhases);
 BENCHMARK(BM_Augmented)->Apply(windowsAndPhases);
 
-// Collects the medians to print the comparison table after the usual output.
-class MedianCollector : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      if (run.run_type != Run::RT_Aggregate || run.aggregate_name != "median") continue;
-      medians[run.run_name.function_name][run.run_name.args] = run.GetAdjustedRealTime();
-    }
-  }
-  std::map<std::string, std::map<std::string, double>> medians;  // function -> "window/phase" -> us
-};
 
 // Runs both filters on the same inputs and returns the largest difference of the newest state and
 // covariance. Frozen linearisation must agree to rounding; relinearised differs at second order.
@@ -180,7 +170,7 @@ double largestDifference(int window, bool relinearize, int cycles, int from_cycl
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  MedianCollector reporter;
+  coloc::bench::MedianCollector reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
 
   std::printf("\nMedian cost per operation, microseconds (augmented = Autoware's extended-state filter)\n");

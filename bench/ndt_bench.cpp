@@ -7,6 +7,8 @@
 //   build/bench/ndt_bench
 #include <benchmark/benchmark.h>
 
+#include "median_collector.hpp"
+
 #include <Eigen/Geometry>
 #include <cstdio>
 #include <map>
@@ -90,23 +92,13 @@ BENCHMARK(BM_AlignDense)->Apply(backends)->Iterations(3);
 BENCHMARK(BM_AlignAutowareSized)->Apply(backends)->Iterations(20);
 BENCHMARK(BM_BuildTargetAls)->Apply(backends)->Iterations(2);
 
-class MedianCollector : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs)
-      if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "median")
-        medians[run.run_name.function_name][run.run_name.args] = run.GetAdjustedRealTime();
-  }
-  std::map<std::string, std::map<std::string, double>> medians;
-};
 
 }  // namespace
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  MedianCollector reporter;
+  coloc::bench::MedianCollector reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   const std::string pcl = std::to_string(static_cast<int>(NdtBackend::kPcl));
   const std::string fast = std::to_string(static_cast<int>(NdtBackend::kFast));

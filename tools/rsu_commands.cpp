@@ -82,12 +82,15 @@ void addRsuListenCommand(CLI::App& app) {
   static DdsOptions dds;
   static std::string registry_path = "config/rsu.yaml";
   static int count = 0;
-  static double timeout = 0.0;
-  static bool dimensions = false;
+  static double timeout = 0.0, idle = 0.0;
+  static std::vector<double> dimensions;
   cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
   cmd->add_option("--count", count, "exit after this many fixes (0 = run until --timeout or Ctrl-C)");
   cmd->add_option("--timeout", timeout, "exit after this many seconds (0 = no limit)");
-  cmd->add_flag("--dimensions", dimensions, "also print vehicle dimensions published on /vehicle/dimensions");
+  cmd->add_option("--idle-exit", idle, "exit once this many seconds pass without a fix, after the first (0 = never)");
+  cmd->add_option("--dimensions", dimensions,
+                  "publish this vehicle's dimensions for the RSUs, twice a second as CAMs repeat: station_id length width")
+      ->expected(3);
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
   addDdsOptions(cmd, dds);
   cmd->callback([] {
@@ -98,6 +101,7 @@ void addRsuListenCommand(CLI::App& app) {
     printSecurity(config);
     std::mutex mutex;
     std::atomic<int> received{0};
+    std::atomic<std::int64_t> last_fix{0};  // steady-clock ns of the newest fix
     rsu_client::FixSubscriber subscriber(config, ids, [&](const rsu_client::RsuFix& fix, Stamp now) {
       std::lock_guard<std::mutex> lock(mutex);
       const rsu_client::FixVerdict v = checker.check(fix, now);
@@ -108,22 +112,27 @@ void addRsuListenCommand(CLI::App& app) {
         std::printf("%s\n", v.detail.c_str());
       std::fflush(stdout);
       ++received;
+      last_fix = std::chrono::steady_clock::now().time_since_epoch().count();
     });
-    std::unique_ptr<rsu_client::DimensionsSubscriber> dims;
-    if (dimensions)
-      dims = std::make_unique<rsu_client::DimensionsSubscriber>(config, [&](const rsu_client::VehicleDimensions& d) {
-        std::lock_guard<std::mutex> lock(mutex);
-        std::printf("dimensions station %u length %.3f width %.3f reference (%.3f, %.3f)\n", d.station_id, d.length, d.width,
-                    d.reference_x, d.reference_y);
-        std::fflush(stdout);
-      });
+    std::unique_ptr<rsu_client::DimensionsPublisher> dims;
+    if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
     std::printf("listening on %zu RSU topics (%s), domain %d\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
                 config.domain);
     std::fflush(stdout);
     const auto start = std::chrono::steady_clock::now();
+    const auto idle_for = [&] {
+      return std::chrono::steady_clock::now() - std::chrono::steady_clock::time_point(std::chrono::steady_clock::duration(last_fix.load()));
+    };
+    auto next_cam = std::chrono::steady_clock::now();
     while ((count == 0 || received.load() < count) &&
-           (timeout <= 0.0 || std::chrono::steady_clock::now() - start < std::chrono::duration<double>(timeout)))
+           (timeout <= 0.0 || std::chrono::steady_clock::now() - start < std::chrono::duration<double>(timeout)) &&
+           (idle <= 0.0 || received.load() == 0 || idle_for() < std::chrono::duration<double>(idle))) {
+      if (dims && std::chrono::steady_clock::now() >= next_cam) {
+        dims->publish({rsu_client::systemNow(), static_cast<std::uint32_t>(dimensions[0]), dimensions[1], dimensions[2], 0.0, 0.0});
+        next_cam += std::chrono::milliseconds(500);
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     std::lock_guard<std::mutex> lock(mutex);
     for (const auto& [id, c] : checker.counters())
       std::printf("summary %s: received %llu accepted %llu unknown_rsu %llu non_finite %llu out_of_coverage %llu stale %llu "
@@ -141,7 +150,7 @@ void addRsuPublishCommand(CLI::App& app) {
   static int generate = 0, wait_subscribers = 1;
   static double rate = 10.0, wait_timeout = 10.0, speed = 10.0;
   static rsu_client::LinkConfig link;
-  static std::vector<double> dimensions;
+  static bool dimensions = false;
   cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
   cmd->add_option("--rsu", rsu, "the RSU id to publish as")->required();
   cmd->add_option("--from", from, "fixes from a CSV file: t_offset_s,x,y per line");
@@ -150,7 +159,7 @@ void addRsuPublishCommand(CLI::App& app) {
   cmd->add_option("--rate", rate, "fixes per second")->capture_default_str();
   cmd->add_option("--wait-subscribers", wait_subscribers, "wait for this many listeners before sending")->capture_default_str();
   cmd->add_option("--wait-timeout", wait_timeout, "seconds to wait for them")->capture_default_str();
-  cmd->add_option("--dimensions", dimensions, "also publish vehicle dimensions: station_id length width")->expected(3);
+  cmd->add_flag("--dimensions", dimensions, "print the vehicle dimensions received on /vehicle/dimensions (the CAM content)");
   cmd->add_option("--delay", link.delay, "emulated link delay, s")->capture_default_str();
   cmd->add_option("--jitter", link.jitter, "emulated delay jitter (standard deviation), s")->capture_default_str();
   cmd->add_option("--loss", link.loss, "emulated independent loss probability")->capture_default_str();
@@ -172,15 +181,20 @@ void addRsuPublishCommand(CLI::App& app) {
     const rsu_client::DdsConfig config = ddsConfig(dds, rsu);
     printSecurity(config);
     rsu_client::FixPublisher publisher(config, rsu);
-    std::unique_ptr<rsu_client::DimensionsPublisher> dims;
-    if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
+    std::mutex print;
+    std::atomic<bool> have_dimensions{false};
+    std::unique_ptr<rsu_client::DimensionsSubscriber> dims;
+    if (dimensions)
+      dims = std::make_unique<rsu_client::DimensionsSubscriber>(config, [&](const rsu_client::VehicleDimensions& d) {
+        if (have_dimensions.exchange(true)) return;  // CAMs repeat: print the first
+        std::lock_guard<std::mutex> lock(print);
+        std::printf("dimensions station %u length %.3f width %.3f reference (%.3f, %.3f)\n", d.station_id, d.length, d.width,
+                    d.reference_x, d.reference_y);
+        std::fflush(stdout);
+      });
     if (wait_subscribers > 0 &&
         !publisher.waitForSubscribers(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000))))
       throw Error("rsu-publish: no listener matched within " + std::to_string(wait_timeout) + " s");
-    if (dims) {
-      dims->waitForSubscribers(1, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)));
-      dims->publish({rsu_client::systemNow(), static_cast<std::uint32_t>(dimensions[0]), dimensions[1], dimensions[2], 0.0, 0.0});
-    }
     rsu_client::LinkEmulator emulator(link);
     const Stamp start = rsu_client::systemNow();
     int sent = 0, dropped = 0;
@@ -199,6 +213,9 @@ void addRsuPublishCommand(CLI::App& app) {
       ++sent;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(200));  // let the last samples leave
+    if (dimensions)  // the vehicle's CAMs come twice a second: a short wait is enough to have one
+      for (int i = 0; i < 200 && !have_dimensions.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::lock_guard<std::mutex> lock(print);
     std::printf("published %d fixes as %s, %d dropped by the emulated link\n", sent, rsu.c_str(), dropped);
   });
 }
