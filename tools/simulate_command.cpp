@@ -25,6 +25,7 @@
 #include "coloc/sim/vehicle_body.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
+#include "svg_plot.hpp"
 
 namespace coloc::tools {
 
@@ -81,7 +82,7 @@ void addSimulateCommand(CLI::App& app) {
   static rsu_client::LinkConfig link;
   static double rsu_processing = 0.01;
   cmd->add_option("SCENARIO", scenario_path, "scenario YAML (see config/scenarios/)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--out", out_dir, "output folder: log/, map/, fuse.yaml, rsu_fixes.csv")->capture_default_str();
+  cmd->add_option("--out", out_dir, "output folder: log/, map/, fuse.yaml, rsu_fixes.csv, rsu_fix_error.svg")->capture_default_str();
   cmd->add_option("--delay", link.delay, "V2I delay of the fixes, s")->capture_default_str();
   cmd->add_option("--jitter", link.jitter, "V2I delay jitter, s")->capture_default_str();
   cmd->add_option("--loss", link.loss, "V2I loss probability")->capture_default_str();
@@ -155,6 +156,7 @@ void addSimulateCommand(CLI::App& app) {
     bag.addTopic(topic("/ground_truth/odom", "nav_msgs/msg/Odometry"));
     for (const Rsu& r : rsus) bag.addTopic(topic("/rsu/" + r.info.id + "/fix", "geometry_msgs/msg/PoseWithCovarianceStamped"));
     std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
+    std::map<std::string, PlotSeries> fix_errors;  // per RSU: error against distance
     fixes_csv << "stamp_s,rsu,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
     const sim::LidarSpec roof = lidarNamed(scenario.vehicle_lidar);
     const sim::OdometryNoise odometry_noise;
@@ -219,6 +221,11 @@ void addSimulateCommand(CLI::App& app) {
           const Eigen::Vector2d error = d.position - seen.position;
           fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << distance << "," << error.x() << "," << error.y() << ","
                     << error.norm() << "," << d.processing_ms << "," << (delivered ? 1 : 0) << "\n";
+          PlotSeries& series = fix_errors[r.info.id];
+          series.label = r.info.id + " (" + r.info.lidar_model + ")";
+          series.points = true;
+          series.x.push_back(distance);
+          series.y.push_back(error.norm());
           if (!delivered) continue;
           io::StampedPose fix;
           fix.header = {at(capture), "map"};
@@ -233,6 +240,15 @@ void addSimulateCommand(CLI::App& app) {
     }
     progress.finish();
     bag.close();
+    if (!fix_errors.empty()) {
+      Plot plot;
+      plot.title = "RSU fix error against distance from the RSU: " + scenario.name;
+      plot.x_label = "distance from the RSU [m]";
+      plot.y_label = "fix error [m]";
+      plot.y_from_zero = true;
+      for (auto& [id, series] : fix_errors) plot.series.push_back(series);
+      writeSvg(out_dir + "/rsu_fix_error.svg", plot);
+    }
     // 5. How to replay it: NDT needs a first guess; the twin knows where the drive starts.
     std::ofstream fuse(out_dir + "/fuse.yaml");
     fuse << "# coloc fuse " << out_dir << "/log --map " << out_dir << "/map --config " << out_dir << "/fuse.yaml\n"
@@ -245,7 +261,7 @@ void addSimulateCommand(CLI::App& app) {
                 (unsigned long long)fixes, timing.rays / std::max(timing.ray_casting, 1e-9) * 1e-6);
     std::printf("  time: survey map %.1f s, ray casting %.1f s, roadside perception %.2f s, the rest %.1f s\n", timing.map,
                 timing.ray_casting, timing.perception, wall - timing.map - timing.ray_casting - timing.perception);
-    std::printf("  wrote %s/{log/, map/, fuse.yaml, rsu_fixes.csv}\n", out_dir.c_str());
+    std::printf("  wrote %s/{log/, map/, fuse.yaml, rsu_fixes.csv, rsu_fix_error.svg}\n", out_dir.c_str());
   });
 }
 
