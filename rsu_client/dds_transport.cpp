@@ -34,8 +34,10 @@ Stamp systemNow() {
 
 namespace {
 
-dds::DataReaderQos readerQos(const DdsConfig& c) {
-  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+// Readers and writers get the same QoS: ROS 2 sensor data by default (best effort, keep last 5,
+// volatile), reliable on request.
+template <typename Qos>
+Qos withConfig(Qos q, const DdsConfig& c) {
   q.reliability().kind = c.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
   q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   q.history().depth = c.depth;
@@ -43,14 +45,8 @@ dds::DataReaderQos readerQos(const DdsConfig& c) {
   return q;
 }
 
-dds::DataWriterQos writerQos(const DdsConfig& c) {
-  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = c.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
-  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = c.depth;
-  q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-  return q;
-}
+dds::DataReaderQos readerQos(const DdsConfig& c) { return withConfig(dds::DATAREADER_QOS_DEFAULT, c); }
+dds::DataWriterQos writerQos(const DdsConfig& c) { return withConfig(dds::DATAWRITER_QOS_DEFAULT, c); }
 
 void setStamp(std_msgs::msg::Header& header, Stamp stamp, const std::string& frame) {
   const Stamp sec = stamp >= 0 ? stamp / kNanosPerSecond : (stamp - kNanosPerSecond + 1) / kNanosPerSecond;
