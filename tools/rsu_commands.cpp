@@ -12,6 +12,7 @@
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "commands.hpp"
+#include "teardown_watchdog.hpp"
 
 namespace coloc::tools {
 
@@ -116,6 +117,7 @@ void addRsuListenCommand(CLI::App& app) {
     });
     std::unique_ptr<rsu_client::DimensionsPublisher> dims;
     if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
+    const TeardownWatchdog watchdog("rsu-listen");
     std::printf("listening on %zu RSU topics (%s), domain %d\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
                 config.domain);
     std::fflush(stdout);
@@ -192,6 +194,7 @@ void addRsuPublishCommand(CLI::App& app) {
                     d.reference_x, d.reference_y);
         std::fflush(stdout);
       });
+    const TeardownWatchdog watchdog("rsu-publish");
     if (wait_subscribers > 0 &&
         !publisher.waitForSubscribers(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000))))
       throw Error("rsu-publish: no listener matched within " + std::to_string(wait_timeout) + " s");

@@ -9,23 +9,23 @@ coloc=$1
 registry=$2
 make_security=$3
 source "$(dirname "$0")/../support/in_network_namespace.sh"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/../support/process_logs.sh"
 "$make_security" "$work/sec" rsu_a rsu_b > /dev/null
 # Intruders send from x = 999 so that any of their fixes that got through would stand out.
 printf '0.0,999,0\n0.1,999,0\n0.2,999,0\n0.3,999,0\n' > "$work/intruder.csv"
 
 # The listener stops 8 s after the RSU's last fix (the intruders have tried by then), or after 60 s.
-"$coloc" rsu-listen --registry "$registry" --reliable --security "$work/sec" --name vehicle --timeout 60 --idle-exit 8 > "$work/listen.txt" 2>&1 &
+bounded 80 "$work/listen.txt" "$coloc" rsu-listen --registry "$registry" --reliable --security "$work/sec" --name vehicle \
+  --timeout 60 --idle-exit 8 &
 listener=$!
-"$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --generate 6 --rate 10 --security "$work/sec" > "$work/rsu.txt" 2>&1
+bounded 30 "$work/rsu.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --generate 6 --rate 10 --security "$work/sec"
 # The rogue intruder sends without waiting for a match (it will never get one).
-"$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name intruder_rogue --security "$work/sec/rogue" \
-  --from "$work/intruder.csv" --wait-subscribers 0 > "$work/rogue.txt" 2>&1 || true
-"$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name intruder_listed --security "$work/sec" \
-  --from "$work/intruder.csv" --wait-subscribers 0 > "$work/listed.txt" 2>&1 || true
-"$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name plain --from "$work/intruder.csv" \
-  --wait-subscribers 0 > "$work/plain.txt" 2>&1 || true
+bounded 20 "$work/rogue.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name intruder_rogue \
+  --security "$work/sec/rogue" --from "$work/intruder.csv" --wait-subscribers 0 || true
+bounded 20 "$work/listed.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name intruder_listed \
+  --security "$work/sec" --from "$work/intruder.csv" --wait-subscribers 0 || true
+bounded 20 "$work/plain.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name plain \
+  --from "$work/intruder.csv" --wait-subscribers 0 || true
 wait "$listener"
 for f in rsu rogue listed plain listen; do echo "== $f"; grep -v 'SECURITY\|DATA_WRITER\|Function' "$work/$f.txt" || true; done
 

@@ -8,17 +8,16 @@ set -euo pipefail
 coloc=$1
 registry=$2
 source "$(dirname "$0")/../support/in_network_namespace.sh"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/../support/process_logs.sh"
 printf '0.00,95,-3\n0.05,96,-3\n0.10,500,500\n' > "$work/extra.csv"
 
 # The listener stops 4 s after the last fix (both publishers have sent by then), or after 60 s.
 # Reliable QoS: the losses counted here must be the emulated link's, not best effort's.
-"$coloc" rsu-listen --registry "$registry" --reliable --timeout 60 --idle-exit 4 --dimensions 7 4.8 1.9 > "$work/listen.txt" 2>&1 &
+bounded 80 "$work/listen.txt" "$coloc" rsu-listen --registry "$registry" --reliable --timeout 60 --idle-exit 4 --dimensions 7 4.8 1.9 &
 listener=$!
-"$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --generate 20 --rate 20 --loss 0.25 --seed 3 \
-  --dimensions > "$work/publish.txt" 2>&1
-"$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --from "$work/extra.csv" > "$work/publish2.txt" 2>&1
+bounded 30 "$work/publish.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --generate 20 --rate 20 --loss 0.25 \
+  --seed 3 --dimensions
+bounded 30 "$work/publish2.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --from "$work/extra.csv"
 wait "$listener"
 cat "$work/publish.txt" "$work/publish2.txt" "$work/listen.txt"
 
