@@ -11,5 +11,6 @@ void addAlignCommand(CLI::App& app);
 void addRsuListenCommand(CLI::App& app);
 void addRsuPublishCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
+void addExperimentCommand(CLI::App& app);
 
 }  // namespace coloc::tools

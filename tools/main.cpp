@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   coloc::tools::addRsuListenCommand(app);
   coloc::tools::addRsuPublishCommand(app);
   coloc::tools::addSimulateCommand(app);
+  coloc::tools::addExperimentCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

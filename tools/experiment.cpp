@@ -1,0 +1,338 @@
+#include "experiment.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "coloc/core/error.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+#include "coloc/sim/scene.hpp"
+#include "coloc/sim/vehicle_motion.hpp"
+#include "fuse_config.hpp"
+#include "log_replay.hpp"
+#include "twin_recording.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// "VLP-32C" -> "vlp32c": a suffix for the RSU id, hence the topic.
+std::string slug(const std::string& lidar) {
+  std::string s;
+  for (char c : lidar)
+    if (std::isalnum(static_cast<unsigned char>(c))) s += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string rsuIdFor(const sim::ScenarioRsu& rsu, const std::string& lidar) { return rsu.id + "_" + slug(lidar); }
+
+// The site's scenario with every compared LiDAR model mounted at each of its RSUs (one virtual sensor
+// each: they do not disturb one another, so one drive serves all).
+sim::Scenario siteScenario(const std::string& site, const std::vector<std::string>& lidars) {
+  sim::Scenario s = sim::parseScenario(scenarioText(site), site);
+  std::vector<sim::ScenarioRsu> rsus;
+  for (const sim::ScenarioRsu& r : s.rsus)
+    for (const std::string& lidar : lidars) {
+      sim::ScenarioRsu copy = r;
+      copy.id = rsuIdFor(r, lidar);
+      copy.lidar_model = lidar;
+      rsus.push_back(copy);
+    }
+  s.rsus = rsus;
+  return s;
+}
+
+SiteInfo siteInfo(const sim::Scenario& s) {
+  SiteInfo info;
+  info.name = s.name;
+  const sim::Drive drive(sim::Route(s.route_start, s.route_heading, s.route), s.speed);
+  // Sample the path finely and find where each RSU is nearest.
+  std::vector<std::pair<double, Eigen::Vector2d>> path;
+  double along = 0.0;
+  Eigen::Vector2d last = drive.at(0.0).position;
+  for (double t = 0.0; t <= drive.duration(); t += 0.01) {
+    const Eigen::Vector2d p = drive.at(t).position;
+    along += (p - last).norm();
+    last = p;
+    path.push_back({along, p});
+  }
+  info.drive_length = along;
+  std::vector<std::string> seen;
+  for (const sim::ScenarioRsu& r : s.rsus) {
+    const std::string key = std::to_string(r.position.x()) + "," + std::to_string(r.position.y());
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
+    seen.push_back(key);
+    double best = 1e300, best_along = 0.0;
+    for (const auto& [a, p] : path)
+      if ((p - r.position).norm() < best) best = (p - r.position).norm(), best_along = a;
+    info.rsu_along.push_back(best_along);
+  }
+  return info;
+}
+
+struct Job {
+  ExperimentRun run;
+  std::string log, map;
+  FuseConfig config;
+  std::string fix_topic;  ///< the fused RSU topic, empty for NDT only
+  std::vector<Eigen::Vector2d> rsu_positions;
+};
+
+// Replays one configuration and measures its error along the drive.
+void runJob(Job& job) {
+  ReplayOptions options;
+  options.config = job.config;
+  options.map = job.map;
+  const ReplayResult r = replayLog(job.log, options);
+  // Distance along the drive at each ground-truth sample.
+  std::vector<double> along(r.ground_truth.size(), 0.0);
+  for (std::size_t i = 1; i < r.ground_truth.size(); ++i)
+    along[i] = along[i - 1] + (r.ground_truth[i].pose.position.head<2>() - r.ground_truth[i - 1].pose.position.head<2>()).norm();
+  for (const ErrorSample& e : r.errors) {
+    const auto it = std::lower_bound(r.ground_truth.begin(), r.ground_truth.end(), e.stamp,
+                                     [](const io::TrajectoryPoint& p, Stamp s) { return p.stamp < s; });
+    const std::size_t i = std::min<std::size_t>(it - r.ground_truth.begin(), along.size() - 1);
+    double to_rsu = 1e300;
+    for (const Eigen::Vector2d& p : job.rsu_positions) to_rsu = std::min(to_rsu, (e.truth - p).norm());
+    job.run.along.push_back(along[i]);
+    job.run.to_rsu.push_back(to_rsu);
+    job.run.error.push_back(e.error);
+  }
+  for (const fusion::SourceReport& s : r.sources)
+    if (!job.fix_topic.empty() && s.name == job.fix_topic) {
+      job.run.fixes_applied = s.counters.applied;
+      job.run.fixes_gated = s.counters.gated;
+    }
+  for (const TopicUse& t : r.topics)
+    if (t.topic == job.fix_topic) job.run.fixes_lost = t.link_dropped;
+  job.run.replay_seconds = r.wall_seconds;
+}
+
+// Runs the jobs side by side; the first error stops the rest and is rethrown.
+void runJobs(std::vector<Job>& jobs, int threads) {
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex mutex;
+  auto worker = [&] {
+    for (std::size_t i; (i = next++) < jobs.size();) {
+      try {
+        runJob(jobs[i]);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = jobs.size();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min<int>(threads, static_cast<int>(jobs.size())); ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+Vector6d fixVariance(double v) { return (Vector6d() << v, v, kInfinity, kInfinity, kInfinity, kInfinity).finished(); }
+
+// Mean squared planar error of the fixes a recording's RSU made, per axis: the "estimated from the
+// data" covariance of the sweep, as a calibration drive past the RSU would give it.
+double measuredFixVariance(const std::string& fixes_csv, const std::string& rsu_id) {
+  std::ifstream in(fixes_csv);
+  std::string line;
+  std::getline(in, line);
+  double sum = 0.0;
+  int n = 0;
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::vector<std::string> f;
+    for (std::string cell; std::getline(s, cell, ',');) f.push_back(cell);
+    if (f.size() < 7 || f[1] != rsu_id) continue;
+    const double ex = std::stod(f[4]), ey = std::stod(f[5]);
+    sum += 0.5 * (ex * ex + ey * ey);
+    ++n;
+  }
+  if (n < 2) throw Error(fixes_csv + ": too few fixes of " + rsu_id + " to estimate their variance");
+  return sum / n;
+}
+
+}  // namespace
+
+std::string ExperimentRun::label() const {
+  if (lidar.empty()) return variant.empty() ? "NDT only" : "NDT only, " + variant;
+  std::string s = "NDT + " + lidar;
+  if (delay > 0.0 || loss > 0.0) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, ", %.0f ms, %.0f %% loss", delay * 1e3, loss * 1e2);
+    s += buf;
+  }
+  if (!variant.empty()) s += ", " + variant;
+  return s;
+}
+
+ExperimentResults runExperiment(const ExperimentConfig& config, const std::string& out_dir, const ExperimentProgress& progress) {
+  const auto start = Clock::now();
+  ExperimentResults results;
+  results.config = config;
+  results.work_dir = out_dir + "/recordings";
+  FuseConfig base = config.fuse_config.empty() ? FuseConfig{} : loadFuseConfig(config.fuse_config);
+  base.ndt.source.ndt.threads = 1;  // the replays run side by side instead: small scans scale poorly over threads
+
+  // The work, counted in drives; each drive is followed by its replays.
+  struct Drive {
+    std::size_t site;
+    int trial;
+    std::string variant;  ///< sweep drives
+    double rsu_height = 0.0, speed = 0.0;
+  };
+  std::vector<Drive> drives;
+  for (std::size_t s = 0; s < config.sites.size(); ++s)
+    for (int t = 0; t < config.trials; ++t) drives.push_back({s, t, "", 0.0, 0.0});
+  if (config.sweeps)
+    for (std::size_t s = 0; s < config.sites.size(); ++s)
+      for (int t = 0; t < std::min(config.sweep_trials, config.trials); ++t) {
+        for (double h : config.rsu_heights) drives.push_back({s, t, "RSU height", h, 0.0});
+        for (double v : config.speeds) drives.push_back({s, t, "speed", 0.0, v});
+      }
+
+  std::vector<sim::Scenario> scenarios;
+  std::vector<std::string> maps(config.sites.size());
+  for (const std::string& site : config.sites) {
+    scenarios.push_back(siteScenario(site, config.lidars));
+    results.sites.push_back(siteInfo(scenarios.back()));
+  }
+  std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU topic -> variance
+
+  for (std::size_t d = 0; d < drives.size(); ++d) {
+    const Drive& drive = drives[d];
+    sim::Scenario scenario = scenarios[drive.site];
+    scenario.seed += 1000 * static_cast<std::uint64_t>(drive.trial);  // trial 0 is the scenario as written
+    std::string name = scenario.name + "/trial_" + std::to_string(drive.trial);
+    std::string variant;
+    char buf[64];
+    if (drive.variant == "RSU height") {
+      for (sim::ScenarioRsu& r : scenario.rsus) r.height = drive.rsu_height;
+      std::snprintf(buf, sizeof buf, "RSU height %.1f m", drive.rsu_height);
+      variant = buf;
+      std::snprintf(buf, sizeof buf, "_height_%.1f", drive.rsu_height);
+      name += buf;
+    } else if (drive.variant == "speed") {
+      scenario.speed.cruise = drive.speed;
+      std::snprintf(buf, sizeof buf, "speed %.0f m/s", drive.speed);
+      variant = buf;
+      std::snprintf(buf, sizeof buf, "_speed_%.0f", drive.speed);
+      name += buf;
+    }
+    // The drive.
+    const auto t0 = Clock::now();
+    TwinRecordingOptions rec;
+    rec.out_dir = results.work_dir + "/" + name;
+    fs::remove_all(rec.out_dir);
+    rec.map_dir = maps[drive.site];
+    rec.perception_ablation = drive.trial == 0 && drive.variant.empty();
+    const TwinRecordingSummary summary = recordTwin(scenario, rec);
+    if (maps[drive.site].empty()) {
+      maps[drive.site] = summary.map_dir;
+      results.timing.survey += summary.map_seconds;
+    }
+    results.timing.simulation += summary.wall_seconds - summary.map_seconds;
+    results.timing.ray_casting += summary.ray_casting_seconds;
+    results.timing.perception += summary.perception_seconds;
+    results.timing.rays += summary.rays;
+    results.timing.driven_seconds += summary.drive_seconds;
+    const double simulated_in = since(t0);
+
+    // Its replays.
+    FuseConfig fuse = base;
+    fuse.replay.initial_pose = Eigen::Vector4d(scenario.route_start.x(), scenario.route_start.y(), 0.0, scenario.route_heading);
+    fuse.ndt.source.lidar_pose = Vector6d::Zero();
+    fuse.ndt.source.lidar_pose[2] = scenario.vehicle_lidar_height;
+    std::vector<Eigen::Vector2d> rsu_positions;
+    for (const sim::ScenarioRsu& r : scenario.rsus) rsu_positions.push_back(r.position);
+    auto makeJob = [&](const std::string& lidar, double delay, double loss, const std::string& job_variant,
+                       std::optional<double> variance) {
+      Job job;
+      job.run.site = scenario.name;
+      job.run.trial = drive.trial;
+      job.run.lidar = lidar;
+      job.run.delay = delay;
+      job.run.loss = loss;
+      job.run.variant = job_variant;
+      job.log = rec.out_dir + "/log";
+      job.map = maps[drive.site];
+      job.config = fuse;
+      job.rsu_positions = rsu_positions;
+      for (const sim::ScenarioRsu& r : scenario.rsus) {
+        InputConfig input;
+        const std::string topic = rsuFixTopic(r.id);
+        if (r.lidar_model == lidar) {
+          input.role = InputRole::kPose;
+          input.source = topic;
+          job.fix_topic = topic;
+          if (variance) input.covariance_diagonal = fixVariance(*variance);
+          if (delay > 0.0 || loss > 0.0) {
+            rsu_client::LinkConfig link;
+            link.delay = delay;
+            link.loss = loss;
+            link.seed = 7919 * (drive.trial + 1) + static_cast<std::uint64_t>(std::llround(delay * 1e4 + loss * 1e2));
+            input.link = link;
+          }
+        }
+        job.config.inputs[topic] = input;
+      }
+      return job;
+    };
+    std::vector<Job> jobs;
+    if (drive.variant.empty()) {
+      jobs.push_back(makeJob("", 0.0, 0.0, "", std::nullopt));
+      for (const std::string& lidar : config.lidars) {
+        for (double delay : config.delays)
+          for (double loss : config.losses)
+            if ((delay == 0.0 && loss == 0.0) || config.network) jobs.push_back(makeJob(lidar, delay, loss, "", std::nullopt));
+      }
+      if (config.sweeps && drive.trial < config.sweep_trials) {
+        for (const sim::ScenarioRsu& r : scenario.rsus) {
+          const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
+          jobs.push_back(makeJob(r.lidar_model, 0.0, 0.0, "covariance sigma^2", model->sigma * model->sigma));
+          // Estimated on trial 0's drive (a calibration pass), used for every trial.
+          auto& measured = measured_variance[drive.site];
+          if (!measured.count(r.id)) measured[r.id] = measuredFixVariance(rec.out_dir + "/rsu_fixes.csv", r.id);
+          jobs.push_back(makeJob(r.lidar_model, 0.0, 0.0, "covariance estimated", measured[r.id]));
+        }
+      }
+    } else {
+      if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
+      for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, std::nullopt));
+    }
+    const auto t1 = Clock::now();
+    runJobs(jobs, config.jobs);
+    for (Job& j : jobs) {
+      results.timing.replay += j.run.replay_seconds;
+      results.runs.push_back(std::move(j.run));
+    }
+    results.timing.replays += jobs.size();
+    if (progress.fraction) progress.fraction(static_cast<double>(d + 1) / drives.size());
+    if (progress.step) {
+      char line[256];
+      std::snprintf(line, sizeof line, "[%zu/%zu] %s%s%s: drive simulated in %.1f s, %zu replays in %.1f s", d + 1, drives.size(),
+                    name.c_str(), variant.empty() ? "" : ", ", variant.c_str(), simulated_in, jobs.size(), since(t1));
+      progress.step(line);
+    }
+  }
+  results.timing.total = since(start);
+  return results;
+}
+
+}  // namespace coloc::tools

@@ -1,0 +1,62 @@
+#pragma once
+// The paper's experiment on the digital twin. Per site and trial one drive is simulated with every
+// roadside LiDAR model at the site's RSU, and that one recording is replayed through NDT + EKF once per
+// configuration (NDT only; NDT + each LiDAR's fixes; the same under each network cell), with the fused
+// pose as NDT's initial guess as on a vehicle. The configurations of a trial share the drive and the
+// scans, so their comparison is paired.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "experiment_config.hpp"
+
+namespace coloc::tools {
+
+/// One replay: which site, trial and configuration, and the error along the road.
+struct ExperimentRun {
+  std::string site;
+  int trial = 0;
+  std::string lidar;           ///< empty: NDT only
+  double delay = 0.0, loss = 0.0;
+  std::string variant;         ///< sweep runs: what was varied ("" in the main experiment)
+  // At every fused tick with ground truth:
+  std::vector<double> along;   ///< m along the drive
+  std::vector<double> to_rsu;  ///< m from the nearest RSU
+  std::vector<double> error;   ///< m, planar
+  std::uint64_t fixes_applied = 0, fixes_gated = 0, fixes_lost = 0;
+  double replay_seconds = 0.0;
+
+  std::string label() const;  ///< "NDT only", "NDT + VLP-16", "NDT + VLP-16, 30 ms, 20 % loss"
+};
+
+struct ExperimentTiming {
+  double total = 0.0, survey = 0.0, simulation = 0.0, replay = 0.0;  ///< s; replay summed over the jobs
+  double ray_casting = 0.0, perception = 0.0;                         ///< s, within simulation
+  std::uint64_t rays = 0, replays = 0;
+  double driven_seconds = 0.0;  ///< s of simulated driving
+};
+
+struct SiteInfo {
+  std::string name;
+  double drive_length = 0.0;            ///< m
+  std::vector<double> rsu_along;        ///< m along the drive where each RSU is nearest the road
+};
+
+struct ExperimentResults {
+  ExperimentConfig config;
+  std::vector<SiteInfo> sites;
+  std::vector<ExperimentRun> runs;
+  ExperimentTiming timing;
+  std::string work_dir;  ///< the recordings
+};
+
+struct ExperimentProgress {
+  std::function<void(const std::string& line)> step;  ///< a line per finished stage
+  std::function<void(double fraction)> fraction;
+};
+
+/// Runs everything `config` asks for; recordings go to out_dir/recordings. Throws coloc::Error for
+/// bad scenarios or unwritable folders.
+ExperimentResults runExperiment(const ExperimentConfig& config, const std::string& out_dir, const ExperimentProgress& progress);
+
+}  // namespace coloc::tools

@@ -1,0 +1,67 @@
+// `coloc experiment [FILE] [--quick] [--trials N] [--out DIR]`: the paper's experiment on the digital
+// twin, end to end (see experiment.hpp), with its tables and figures (see experiment_report.hpp).
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "commands.hpp"
+#include "experiment.hpp"
+#include "experiment_report.hpp"
+
+namespace coloc::tools {
+
+void addExperimentCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("experiment",
+                                 "The paper's experiment on the digital twin: NDT only against NDT + roadside fusion with a VLP-16 and a "
+                                 "VLP-32C, at sites A and B, over trials and a network grid; tables and figures");
+  static std::string file, out_dir = "results/experiment";
+  static int trials = 0, jobs = 0;
+  static bool quick = false, sweeps = false, no_network = false;
+  cmd->add_option("FILE", file, "experiment YAML overriding the defaults (keys: see experiment_config.hpp or the README)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", out_dir, "results folder")->capture_default_str();
+  cmd->add_option("--trials", trials, "trials per site (default 10)");
+  cmd->add_flag("--quick", quick, "one trial of everything: a first look in a minute or two");
+  cmd->add_flag("--sweeps", sweeps, "also sweep the RSU covariance, the RSU height and the speed");
+  cmd->add_flag("--no-network", no_network, "skip the network grid (Tables II and III)");
+  cmd->add_option("--jobs", jobs, "replays run side by side (default 2)");
+  cmd->callback([app = &app] {
+    ExperimentConfig config = file.empty() ? ExperimentConfig{} : loadExperimentConfig(file);
+    if (quick) config = quickExperiment(config);
+    if (trials > 0) config.trials = trials;
+    if (jobs > 0) config.jobs = jobs;
+    if (sweeps) config.sweeps = true;
+    if (no_network) config.network = false;
+    std::filesystem::create_directories(out_dir);
+    std::string command_line = "coloc experiment";
+    for (const std::string& a : app->get_subcommand("experiment")->remaining()) command_line += " " + a;
+    if (!file.empty()) command_line += " " + file;
+    if (quick) command_line += " --quick";
+    if (trials > 0) command_line += " --trials " + std::to_string(trials);
+    if (sweeps) command_line += " --sweeps";
+    if (no_network) command_line += " --no-network";
+    std::printf("coloc experiment: %zu site(s), %d trial(s), roadside LiDARs", config.sites.size(), config.trials);
+    for (const std::string& l : config.lidars) std::printf(" %s", l.c_str());
+    std::printf(config.network ? ", network grid %zux%zu" : ", no network grid", config.delays.size(), config.losses.size());
+    std::printf("%s -> %s\n", config.sweeps ? ", sweeps" : "", out_dir.c_str());
+    std::fflush(stdout);
+    // Progress: a line per drive and its replays, with the time left at the pace so far.
+    const auto start = std::chrono::steady_clock::now();
+    double done = 0.0;
+    ExperimentProgress progress;
+    progress.fraction = [&](double f) { done = f; };
+    progress.step = [&](const std::string& line) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::printf("  %s", line.c_str());
+      if (done > 0.0 && done < 1.0) std::printf(" (about %.0f s left)", elapsed * (1.0 - done) / done);
+      std::printf("\n");
+      std::fflush(stdout);
+    };
+    const ExperimentResults results = runExperiment(config, out_dir, progress);
+    const std::string table = writeExperimentReport(results, out_dir, command_line);
+    std::printf("\nTable I: error within coverage (NDT only against NDT + RSU fusion)\n\n%s\n", table.c_str());
+    std::printf("finished in %.0f s; tables, figures and CSVs in %s/ (README.md puts them together)\n", results.timing.total, out_dir.c_str());
+  });
+}
+
+}  // namespace coloc::tools

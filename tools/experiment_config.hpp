@@ -1,0 +1,39 @@
+#pragma once
+// What `coloc experiment` runs, with every default in one place: the paper's two sites, its two
+// roadside LiDARs, its network grid, ten trials. A YAML file may override any key; unknown keys and bad
+// values are errors that name the key and the line.
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace coloc::tools {
+
+struct ExperimentConfig {
+  /// Scenario files, or the names of the built-in scenarios (site_a, site_b: config/scenarios/).
+  std::vector<std::string> sites = {"site_a", "site_b"};
+  int trials = 10;
+  std::vector<std::string> lidars = {"VLP-16", "VLP-32C"};  ///< roadside LiDAR models compared
+  /// The network grid (Tables II and III): every delay crossed with every loss, on top of the fix's
+  /// own processing time. The first cell must be the ideal network (0, 0).
+  std::vector<double> delays = {0.0, 0.010, 0.030};  ///< s
+  std::vector<double> losses = {0.0, 0.10, 0.20};    ///< probability
+  bool network = true;                               ///< run the grid at all
+  double bin_length = 2.0;      ///< m of road per bin of the paper's metric (minimum error per bin)
+  std::string fuse_config;      ///< optional fuse YAML applied to every replay (fusion, ndt, replay keys)
+  int jobs = 2;                 ///< replays run side by side (each NDT on one thread)
+  bool sweeps = false;          ///< also run the sweeps beyond the paper (covariance, RSU height, speed)
+  int sweep_trials = 3;
+  std::vector<double> rsu_heights = {2.0, 3.0, 4.5};  ///< m, sweep
+  std::vector<double> speeds = {5.0, 10.0, 15.0};     ///< m/s, sweep
+};
+
+/// The quick mode: one trial of everything, for a first look in a minute or two.
+ExperimentConfig quickExperiment(ExperimentConfig config);
+
+ExperimentConfig loadExperimentConfig(const std::string& path);
+ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::string& source_name);
+
+/// The scenario's YAML text: a built-in one by name, else the file.
+std::string scenarioText(const std::string& site);
+
+}  // namespace coloc::tools

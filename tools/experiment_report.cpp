@@ -1,0 +1,345 @@
+#include "experiment_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "coloc/core/error.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+#include "svg_plot.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+struct Spread {
+  double mean = 0.0, sd = 0.0, min = 0.0, max = 0.0;
+  std::size_t n = 0;
+};
+
+Spread spread(const std::vector<double>& v) {
+  Spread s;
+  s.n = v.size();
+  if (v.empty()) return s;
+  for (double x : v) s.mean += x;
+  s.mean /= v.size();
+  for (double x : v) s.sd += (x - s.mean) * (x - s.mean);
+  s.sd = v.size() > 1 ? std::sqrt(s.sd / (v.size() - 1)) : 0.0;
+  s.min = *std::min_element(v.begin(), v.end());
+  s.max = *std::max_element(v.begin(), v.end());
+  return s;
+}
+
+std::string fmt(const char* f, double a) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+std::string cm(const Spread& s) {  // "9.9 ± 0.4 cm"
+  char b[64];
+  if (s.n > 1) std::snprintf(b, sizeof b, "%.1f ± %.1f cm", 100 * s.mean, 100 * s.sd);
+  else std::snprintf(b, sizeof b, "%.1f cm", 100 * s.mean);
+  return b;
+}
+double improvement(double baseline, double fused) { return baseline > 0.0 ? 100.0 * (1.0 - fused / baseline) : 0.0; }
+
+double rangeOf(const std::string& lidar) {
+  const rsu_client::LidarModel* m = rsu_client::findLidarModel(lidar);
+  return m ? m->range : 0.0;
+}
+
+bool isMain(const ExperimentRun& r) { return r.variant.empty(); }
+bool isIdeal(const ExperimentRun& r) { return r.delay == 0.0 && r.loss == 0.0; }
+
+const ExperimentRun* find(const std::vector<ExperimentRun>& runs, const std::string& site, int trial, const std::string& lidar,
+                          double delay, double loss, const std::string& variant) {
+  for (const ExperimentRun& r : runs)
+    if (r.site == site && r.trial == trial && r.lidar == lidar && r.delay == delay && r.loss == loss && r.variant == variant) return &r;
+  return nullptr;
+}
+
+// Minimum error in each bin of road: the paper's per-2-m figure.
+std::map<long, double> binMinima(const ExperimentRun& run, double bin) {
+  std::map<long, double> m;
+  for (std::size_t i = 0; i < run.error.size(); ++i) {
+    const long k = static_cast<long>(std::floor(run.along[i] / bin));
+    auto it = m.find(k);
+    if (it == m.end()) m[k] = run.error[i];
+    else it->second = std::min(it->second, run.error[i]);
+  }
+  return m;
+}
+
+const char* colorOf(const std::string& lidar, bool light) {
+  if (lidar.empty()) return light ? "#9ecae1" : "#1f77b4";
+  if (lidar == "VLP-16") return light ? "#fdd0a2" : "#ff7f0e";
+  return light ? "#a1d99b" : "#2ca02c";
+}
+
+// Where along the drive the vehicle is within `range` of the RSU (from a run's samples).
+std::pair<double, double> coverageAlong(const ExperimentRun& run, double range) {
+  double lo = 1e300, hi = -1e300;
+  for (std::size_t i = 0; i < run.error.size(); ++i)
+    if (run.to_rsu[i] <= range) lo = std::min(lo, run.along[i]), hi = std::max(hi, run.along[i]);
+  return {lo, hi};
+}
+
+void writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw Error(path + ": cannot write");
+}
+
+}  // namespace
+
+ErrorInCoverage errorInCoverage(const ExperimentRun& run, double range, double bin_length) {
+  ErrorInCoverage e;
+  std::map<long, double> minima;
+  for (std::size_t i = 0; i < run.error.size(); ++i) {
+    if (run.to_rsu[i] > range) continue;
+    e.plain += run.error[i];
+    ++e.samples;
+    const long k = static_cast<long>(std::floor(run.along[i] / bin_length));
+    auto it = minima.find(k);
+    if (it == minima.end()) minima[k] = run.error[i];
+    else it->second = std::min(it->second, run.error[i]);
+  }
+  if (e.samples == 0) return e;
+  e.plain /= e.samples;
+  for (const auto& [k, v] : minima) e.paper += v;
+  e.paper /= minima.size();
+  return e;
+}
+
+std::string writeExperimentReport(const ExperimentResults& results, const std::string& out_dir, const std::string& command_line) {
+  const ExperimentConfig& c = results.config;
+  const double bin = c.bin_length;
+  std::ostringstream md;
+
+  // runs.csv: every replay's error within each LiDAR's coverage.
+  {
+    std::ostringstream csv;
+    csv << "site,trial,configuration,lidar,delay_s,loss,variant,coverage_lidar,range_m,error_paper_m,error_mean_m,samples,fixes_applied,"
+           "fixes_gated,fixes_lost,replay_s\n";
+    for (const ExperimentRun& r : results.runs)
+      for (const std::string& lidar : c.lidars) {
+        const ErrorInCoverage e = errorInCoverage(r, rangeOf(lidar), bin);
+        csv << r.site << "," << r.trial << ",\"" << r.label() << "\"," << r.lidar << "," << r.delay << "," << r.loss << ",\"" << r.variant
+            << "\"," << lidar << "," << rangeOf(lidar) << "," << e.paper << "," << e.plain << "," << e.samples << "," << r.fixes_applied << ","
+            << r.fixes_gated << "," << r.fixes_lost << "," << r.replay_seconds << "\n";
+      }
+    writeFile(out_dir + "/runs.csv", csv.str());
+  }
+
+  // Table I.
+  std::ostringstream table1, table1_csv;
+  table1 << "| site | roadside LiDAR | coverage | NDT only | NDT + RSU | improvement | NDT only (all samples) | NDT + RSU (all samples) | "
+            "improvement (all samples) |\n|---|---|---|---|---|---|---|---|---|\n";
+  table1_csv << "site,lidar,range_m,trials,ndt_paper_m,ndt_paper_sd,fused_paper_m,fused_paper_sd,improvement_paper_pct,improvement_min_pct,"
+                "improvement_max_pct,ndt_mean_m,fused_mean_m,improvement_mean_pct\n";
+  for (const SiteInfo& site : results.sites)
+    for (const std::string& lidar : c.lidars) {
+      const double range = rangeOf(lidar);
+      std::vector<double> ndt_p, fused_p, ndt_m, fused_m, gain;
+      for (int t = 0; t < c.trials; ++t) {
+        const ExperimentRun* ndt = find(results.runs, site.name, t, "", 0, 0, "");
+        const ExperimentRun* fused = find(results.runs, site.name, t, lidar, 0, 0, "");
+        if (!ndt || !fused) continue;
+        const ErrorInCoverage a = errorInCoverage(*ndt, range, bin), b = errorInCoverage(*fused, range, bin);
+        ndt_p.push_back(a.paper), fused_p.push_back(b.paper), ndt_m.push_back(a.plain), fused_m.push_back(b.plain);
+        gain.push_back(improvement(a.paper, b.paper));
+      }
+      const Spread np = spread(ndt_p), fp = spread(fused_p), nm = spread(ndt_m), fm = spread(fused_m), g = spread(gain);
+      table1 << "| " << site.name << " | " << lidar << " | " << fmt("%.0f m", range) << " | " << cm(np) << " | " << cm(fp) << " | "
+             << fmt("%.0f %%", improvement(np.mean, fp.mean)) << (g.n > 1 ? fmt(" (%.0f", g.min) + fmt("-%.0f)", g.max) : "") << " | "
+             << cm(nm) << " | " << cm(fm) << " | " << fmt("%.0f %%", improvement(nm.mean, fm.mean)) << " |\n";
+      table1_csv << site.name << "," << lidar << "," << range << "," << np.n << "," << np.mean << "," << np.sd << "," << fp.mean << "," << fp.sd
+                 << "," << improvement(np.mean, fp.mean) << "," << g.min << "," << g.max << "," << nm.mean << "," << fm.mean << ","
+                 << improvement(nm.mean, fm.mean) << "\n";
+    }
+  writeFile(out_dir + "/table1.csv", table1_csv.str());
+
+  // Tables II and III: the network grid, per LiDAR, over sites and trials.
+  std::ostringstream network_md, network_csv;
+  network_csv << "lidar,delay_s,loss,error_paper_m,error_mean_m,change_pct,fixes_lost\n";
+  Plot network_plot;
+  network_plot.title = "Fused error within coverage under network delay and loss (mean over sites and trials)";
+  network_plot.x_label = "packet loss [%]";
+  network_plot.y_label = "error within coverage [cm] (minimum per " + fmt("%.0f", bin) + " m, mean)";
+  network_plot.y_from_zero = true;
+  if (c.network) {
+    int table = 2;
+    for (const std::string& lidar : c.lidars) {
+      const double range = rangeOf(lidar);
+      auto cell = [&](double delay, double loss, double* plain, std::uint64_t* lost) {
+        double sum = 0.0, sum_plain = 0.0;
+        int n = 0;
+        std::uint64_t l = 0;
+        for (const SiteInfo& site : results.sites)
+          for (int t = 0; t < c.trials; ++t)
+            if (const ExperimentRun* r = find(results.runs, site.name, t, lidar, delay, loss, "")) {
+              const ErrorInCoverage e = errorInCoverage(*r, range, bin);
+              sum += e.paper, sum_plain += e.plain, l += r->fixes_lost, ++n;
+            }
+        if (plain) *plain = n ? sum_plain / n : 0.0;
+        if (lost) *lost = l;
+        return n ? sum / n : 0.0;
+      };
+      const double ideal = cell(0, 0, nullptr, nullptr);
+      network_md << "\n**Table " << (table == 2 ? "II" : table == 3 ? "III" : std::to_string(table).c_str()) << ": NDT + " << lidar
+                 << " within " << fmt("%.0f m", range) << ", by delay and loss (change against the ideal network)**\n\n| delay |";
+      ++table;
+      for (double loss : c.losses) network_md << fmt(" %.0f %% loss |", 100 * loss);
+      network_md << "\n|---|";
+      for (std::size_t i = 0; i < c.losses.size(); ++i) network_md << "---|";
+      network_md << "\n";
+      for (double delay : c.delays) {
+        network_md << fmt("| %.0f ms |", 1e3 * delay);
+        PlotSeries series;
+        series.label = lidar + fmt(", %.0f ms", 1e3 * delay);
+        for (double loss : c.losses) {
+          double plain = 0.0;
+          std::uint64_t lost = 0;
+          const double e = cell(delay, loss, &plain, &lost);
+          const double change = ideal > 0.0 ? 100.0 * (e / ideal - 1.0) : 0.0;
+          network_md << fmt(" %.2f cm", 100 * e) << (delay == 0.0 && loss == 0.0 ? std::string() : fmt(" (%+.1f %%)", change)) << " |";
+          network_csv << lidar << "," << delay << "," << loss << "," << e << "," << plain << "," << change << "," << lost << "\n";
+          series.x.push_back(100 * loss);
+          series.y.push_back(100 * e);
+        }
+        network_md << "\n";
+        network_plot.series.push_back(series);
+      }
+    }
+    writeFile(out_dir + "/network.csv", network_csv.str());
+    writeSvg(out_dir + "/network.svg", network_plot);
+  }
+
+  // Figures 4 and 5 per site: error along the road (trial 0) and its spread over the trials.
+  std::ostringstream along_csv;
+  along_csv << "site,trial,configuration,bin_start_m,min_error_m\n";
+  std::vector<std::string> configs = {""};
+  for (const std::string& l : c.lidars) configs.push_back(l);
+  for (const SiteInfo& site : results.sites) {
+    Plot fig4, fig5;
+    fig4.title = site.name + ": localization error along the road (minimum per " + fmt("%.0f", bin) + " m), trial 0";
+    fig5.title = site.name + ": error along the road over " + std::to_string(c.trials) + " trials (line: mean, dots: each trial)";
+    for (Plot* p : {&fig4, &fig5}) {
+      p->x_label = "distance along the road [m]";
+      p->y_label = "error [m]";
+      p->y_from_zero = true;
+    }
+    for (const std::string& lidar : configs) {
+      std::map<long, std::vector<double>> per_bin;
+      PlotSeries dots;
+      dots.label = (lidar.empty() ? std::string("NDT only") : "NDT + " + lidar) + ", each trial";
+      dots.points = true;
+      dots.color = colorOf(lidar, true);
+      for (int t = 0; t < c.trials; ++t) {
+        const ExperimentRun* r = find(results.runs, site.name, t, lidar, 0, 0, "");
+        if (!r) continue;
+        const std::map<long, double> minima = binMinima(*r, bin);
+        PlotSeries line;
+        line.label = r->label();
+        line.color = colorOf(lidar, false);
+        for (const auto& [k, v] : minima) {
+          along_csv << site.name << "," << t << ",\"" << r->label() << "\"," << k * bin << "," << v << "\n";
+          per_bin[k].push_back(v);
+          if (t == 0) line.x.push_back((k + 0.5) * bin), line.y.push_back(v);
+          dots.x.push_back((k + 0.5) * bin), dots.y.push_back(v);
+        }
+        if (t == 0) fig4.series.push_back(line);
+      }
+      if (per_bin.empty()) continue;
+      PlotSeries mean;
+      mean.label = (lidar.empty() ? std::string("NDT only") : "NDT + " + lidar) + ", mean";
+      mean.color = colorOf(lidar, false);
+      for (const auto& [k, v] : per_bin) mean.x.push_back((k + 0.5) * bin), mean.y.push_back(spread(v).mean);
+      if (c.trials > 1) fig5.series.push_back(dots);
+      fig5.series.push_back(mean);
+    }
+    if (const ExperimentRun* ndt = find(results.runs, site.name, 0, "", 0, 0, ""))
+      for (const std::string& lidar : c.lidars) {
+        const auto [lo, hi] = coverageAlong(*ndt, rangeOf(lidar));
+        if (lo < hi) {
+          PlotBand band{lo, hi, lidar + fmt(" coverage (%.0f m)", rangeOf(lidar)), colorOf(lidar, false)};
+          fig4.bands.push_back(band);
+          fig5.bands.push_back(band);
+        }
+      }
+    writeSvg(out_dir + "/fig4_error_along_road_" + site.name + ".svg", fig4);
+    writeSvg(out_dir + "/fig5_trials_" + site.name + ".svg", fig5);
+  }
+  writeFile(out_dir + "/error_along_road.csv", along_csv.str());
+
+  // Sweeps: each variant against the paper's setting, on the same trials.
+  std::ostringstream sweeps_md;
+  if (c.sweeps) {
+    std::ostringstream sweeps_csv;
+    sweeps_csv << "variant,lidar,trials,ndt_paper_m,fused_paper_m,improvement_pct,fused_mean_m\n";
+    sweeps_md << "| variant | roadside LiDAR | NDT only | NDT + RSU | improvement | NDT + RSU (all samples) |\n|---|---|---|---|---|---|\n";
+    std::vector<std::string> variants = {""};
+    for (const ExperimentRun& r : results.runs)
+      if (!r.variant.empty() && std::find(variants.begin(), variants.end(), r.variant) == variants.end()) variants.push_back(r.variant);
+    for (const std::string& variant : variants)
+      for (const std::string& lidar : c.lidars) {
+        const double range = rangeOf(lidar);
+        std::vector<double> ndt_v, fused_v, fused_plain;
+        for (const SiteInfo& site : results.sites)
+          for (int t = 0; t < std::min(c.sweep_trials, c.trials); ++t) {
+            const ExperimentRun* fused = find(results.runs, site.name, t, lidar, 0, 0, variant);
+            // The variants that change only the filter share the drive, hence the NDT-only run, of the main experiment.
+            const ExperimentRun* ndt = find(results.runs, site.name, t, "", 0, 0, variant);
+            if (!ndt) ndt = variant.rfind("speed", 0) == 0 ? nullptr : find(results.runs, site.name, t, "", 0, 0, "");
+            if (!fused || !ndt) continue;
+            ndt_v.push_back(errorInCoverage(*ndt, range, bin).paper);
+            fused_v.push_back(errorInCoverage(*fused, range, bin).paper);
+            fused_plain.push_back(errorInCoverage(*fused, range, bin).plain);
+          }
+        if (fused_v.empty()) continue;
+        const Spread n = spread(ndt_v), f = spread(fused_v), fp = spread(fused_plain);
+        const std::string name = variant.empty() ? "as in the paper (covariance as published, RSU at 2 m, 10 m/s)" : variant;
+        sweeps_md << "| " << name << " | " << lidar << " | " << cm(n) << " | " << cm(f) << " | " << fmt("%.0f %%", improvement(n.mean, f.mean))
+                  << " | " << cm(fp) << " |\n";
+        sweeps_csv << "\"" << name << "\"," << lidar << "," << f.n << "," << n.mean << "," << f.mean << "," << improvement(n.mean, f.mean) << ","
+                   << fp.mean << "\n";
+      }
+    writeFile(out_dir + "/sweeps.csv", sweeps_csv.str());
+  }
+
+  // README.md
+  const ExperimentTiming& tm = results.timing;
+  md << "# coloc experiment: cooperative localization on the digital twin\n\n"
+     << "`" << command_line << "`\n\n"
+     << c.trials << " trial(s) per site; sites: ";
+  for (std::size_t i = 0; i < results.sites.size(); ++i) md << (i ? ", " : "") << results.sites[i].name;
+  md << ". Errors are planar, against ground truth, where the vehicle is within the roadside LiDAR's coverage. "
+     << "\"NDT only\" is the same drive and scans without the RSU's fixes. The paper's metric is the minimum error in each "
+     << fmt("%.0f", bin) << " m of road, averaged over the road in coverage; \"all samples\" is the plain mean of the fused pose at 50 Hz. "
+     << "Spread: standard deviation over trials; the improvement's range is over trials.\n\n"
+     << "## Table I: error within coverage\n\n"
+     << table1.str() << "\n";
+  if (c.network) md << "## Tables II and III: network delay and packet loss\n" << network_md.str() << "\n![network](network.svg)\n\n";
+  md << "## Figures\n\n";
+  for (const SiteInfo& site : results.sites)
+    md << "![" << site.name << "](fig4_error_along_road_" << site.name << ".svg)\n![" << site.name << " trials](fig5_trials_" << site.name
+       << ".svg)\n\n";
+  if (c.sweeps) md << "## Sweeps beyond the paper (" << std::min(c.sweep_trials, c.trials) << " trial(s) per site, both sites pooled)\n\n" << sweeps_md.str() << "\n";
+  md << "## Run time\n\n"
+     << fmt("%.0f s in all", tm.total) << fmt(": survey maps %.1f s, ", tm.survey) << fmt("simulating %.0f s of driving ", tm.driven_seconds) << fmt("%.1f s ", tm.simulation)
+     << fmt("(ray casting %.1f s at ", tm.ray_casting) << fmt("%.1f M rays/s, ", tm.rays / std::max(tm.ray_casting, 1e-9) * 1e-6)
+     << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
+     << "(" << c.jobs << " side by side).\n\n"
+     << "## Files\n\n"
+     << "- `table1.csv`, `network.csv`, `sweeps.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
+     << "- `error_along_road.csv`: minimum error per bin along the road, per site, trial and configuration (figures 4 and 5)\n"
+     << "- `recordings/SITE/trial_N/`: each drive as a rosbag2 log with its map and fuse configuration (`coloc fuse` replays it), the "
+        "RSU fixes and, for trial 0, what each perception step buys (`rsu_perception.svg`)\n";
+  writeFile(out_dir + "/README.md", md.str());
+  return table1.str();
+}
+
+}  // namespace coloc::tools

@@ -1,0 +1,315 @@
+#include "twin_recording.hpp"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <random>
+
+#include "coloc/core/error.hpp"
+#include "coloc/io/bag_writer.hpp"
+#include "coloc/io/ros_messages.hpp"
+#include "coloc/ndt/pcd_file.hpp"
+#include "coloc/ndt/tile_map.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+#include "coloc/sim/lidar_model.hpp"
+#include "coloc/sim/roadside_perception.hpp"
+#include "coloc/sim/survey_map.hpp"
+#include "coloc/sim/vehicle_body.hpp"
+#include "svg_plot.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr Stamp kEpoch = 1'700'000'000'000'000'000LL;  // the twin's clock starts here: runs repeat exactly
+
+Stamp at(double t) { return kEpoch + fromSeconds(t); }
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+sim::LidarSpec lidarNamed(const std::string& name) { return name == "VLP-16" ? sim::vlp16() : sim::vlp32c(); }
+
+std::uint64_t raysPerSweep(const sim::LidarSpec& spec) {
+  return spec.vertical_deg.size() * static_cast<std::uint64_t>(std::lround(360.0 / spec.azimuth_step_deg));
+}
+
+io::TopicInfo topic(const std::string& name, const std::string& type) {
+  io::TopicInfo t;
+  t.name = name;
+  t.type = type;
+  return t;
+}
+
+io::PointCloud2 toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp) {
+  io::PointCloud2 m;
+  m.header = {stamp, "lidar"};
+  m.height = 1;
+  m.width = static_cast<std::uint32_t>(points.size());
+  m.fields = {{"x", 0, io::PointField::kFloat32, 1}, {"y", 4, io::PointField::kFloat32, 1}, {"z", 8, io::PointField::kFloat32, 1},
+              {"time", 12, io::PointField::kFloat32, 1}};
+  m.point_step = 16;
+  m.row_step = 16 * m.width;
+  m.is_dense = true;
+  m.data.resize(m.row_step);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::memcpy(&m.data[16 * i], points[i].position.data(), 12);
+    std::memcpy(&m.data[16 * i + 12], &points[i].time, 4);
+  }
+  return m;
+}
+
+Eigen::Isometry3d vehiclePose(const sim::VehicleState& s, double height) {
+  return Eigen::Translation3d(s.position.x(), s.position.y(), height) * Eigen::AngleAxisd(s.yaw, Eigen::Vector3d::UnitZ());
+}
+
+// The perception with and without each of the paper's refinements; the first is the full pipeline,
+// whose result is the fix.
+struct PerceptionVariant {
+  const char* name;
+  bool align_true_size, height_cut;
+};
+constexpr std::array<PerceptionVariant, 4> kVariants = {{{"aligned box with 0.8 m cut", true, true},
+                                                         {"aligned box without cut", true, false},
+                                                         {"plain L-shape centre with 0.8 m cut", false, true},
+                                                         {"plain L-shape centre without cut", false, false}}};
+
+// Mean of y in bins of x, for plots that would be clouds of points otherwise.
+PlotSeries binnedMean(const std::string& label, const std::vector<double>& x, const std::vector<double>& y, double bin) {
+  std::map<long, std::pair<double, int>> bins;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    auto& b = bins[static_cast<long>(std::floor(x[i] / bin))];
+    b.first += y[i];
+    ++b.second;
+  }
+  PlotSeries s;
+  s.label = label;
+  for (const auto& [k, b] : bins) {
+    s.x.push_back((k + 0.5) * bin);
+    s.y.push_back(b.first / b.second);
+  }
+  return s;
+}
+
+void writeMap(const sim::Scenario& scenario, const std::string& dir) {
+  const ndt::PointCloud map = sim::surveyMap(scenario, {});
+  const ndt::TileMap tiles = ndt::TileMap::fromCloud(map, 20.0);
+  fs::create_directories(dir);
+  for (std::size_t i = 0; i < tiles.tiles().size(); ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/tile_%04zu.pcd", i);
+    ndt::savePcd(dir + name, tiles.load(i));
+  }
+}
+
+}  // namespace
+
+std::string rsuFixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/fix"; }
+
+TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordingOptions& options) {
+  const auto wall_start = Clock::now();
+  const std::string& out_dir = options.out_dir;
+  if (fs::exists(out_dir) && !fs::is_empty(out_dir)) throw Error(out_dir + ": the output folder exists and is not empty");
+  fs::create_directories(out_dir);
+  TwinRecordingSummary summary;
+
+  // 1. The survey map, as 20 m PCD tiles (unless an earlier survey is shared).
+  summary.map_dir = options.map_dir.empty() ? out_dir + "/map" : options.map_dir;
+  if (options.map_dir.empty()) {
+    const auto t0 = Clock::now();
+    writeMap(scenario, summary.map_dir);
+    summary.map_seconds = since(t0);
+  }
+
+  // 2. The world: static scene, plus the ego vehicle for the roadside LiDARs.
+  sim::RayCaster scene, with_vehicle;
+  for (const sim::TriangleMesh& m : scenario.worldMeshes()) {
+    scene.addMesh(m);
+    with_vehicle.addMesh(m);
+  }
+  const sim::VehicleBody body;
+  const int body_mesh = with_vehicle.addMesh(body.mesh(1e4, 1e4, 0.0));
+  scene.commit();
+  with_vehicle.commit();
+  const sim::Drive drive(sim::Route(scenario.route_start, scenario.route_heading, scenario.route), scenario.speed);
+  std::mt19937_64 rng(scenario.seed);
+
+  // 3. Roadside units: their background frames and perception.
+  struct Rsu {
+    sim::ScenarioRsu info;
+    sim::LidarSpec lidar;
+    std::vector<sim::RoadsidePerception> perception;  ///< kVariants, or only the first
+    rsu_client::LinkEmulator link;
+    double variance;
+    double range;
+  };
+  std::vector<Rsu> rsus;
+  for (const sim::ScenarioRsu& r : scenario.rsus) {
+    sim::RsuMount mount;
+    mount.position = {r.position.x(), r.position.y(), r.height};
+    mount.yaw = r.yaw;
+    const Eigen::Isometry3d pose = Eigen::Translation3d(mount.position) * Eigen::AngleAxisd(r.yaw, Eigen::Vector3d::UnitZ());
+    std::vector<Eigen::Vector3f> reference;
+    for (const auto& p : sim::scanSweep(lidarNamed(r.lidar_model), scene, [&](double) { return pose; }, rng)) reference.push_back(p.position);
+    const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
+    rsu_client::LinkConfig l = options.link;
+    l.seed = scenario.seed + rsus.size() + 1;
+    std::vector<sim::RoadsidePerception> perception;
+    for (std::size_t v = 0; v < (options.perception_ablation ? kVariants.size() : 1); ++v) {
+      sim::RoadsidePerceptionConfig c;
+      c.align_true_size = kVariants[v].align_true_size;
+      c.height_cut = kVariants[v].height_cut;
+      perception.emplace_back(reference, mount, c);
+    }
+    rsus.push_back({r, lidarNamed(r.lidar_model), std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range});
+  }
+
+  // 4. The drive, recorded.
+  io::BagWriter bag = io::BagWriter::create(out_dir + "/log");
+  bag.addTopic(topic("/points", "sensor_msgs/msg/PointCloud2"));
+  bag.addTopic(topic("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
+  bag.addTopic(topic("/ground_truth/odom", "nav_msgs/msg/Odometry"));
+  for (const Rsu& r : rsus) bag.addTopic(topic(rsuFixTopic(r.info.id), "geometry_msgs/msg/PoseWithCovarianceStamped"));
+  std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
+  fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
+  std::ofstream ablation_csv;
+  if (options.perception_ablation) {
+    ablation_csv.open(out_dir + "/rsu_perception.csv");
+    ablation_csv << "stamp_s,rsu,lidar,distance_m,variant,found,error_m\n";
+  }
+  std::map<std::string, PlotSeries> fix_errors;  // per RSU: error against distance
+  std::map<std::pair<std::string, std::size_t>, std::pair<std::vector<double>, std::vector<double>>> variant_errors;
+  const sim::LidarSpec roof = lidarNamed(scenario.vehicle_lidar);
+  const sim::OdometryNoise odometry_noise;
+  const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
+  for (int k = 0; k <= ticks; ++k) {  // 100 Hz
+    const double t = k * 0.01;
+    const sim::VehicleState truth = drive.at(t);
+    if (options.progress && k % 10 == 0) options.progress(static_cast<double>(k) / ticks);
+    io::Odometry gt;
+    gt.header = {at(t), "map"};
+    gt.child_frame_id = "base_link";
+    gt.pose.pose.position = {truth.position.x(), truth.position.y(), 0.0};
+    gt.pose.pose.orientation = quaternionFromRollPitchYaw(0, 0, truth.yaw);
+    gt.twist.linear = {truth.speed, 0, 0};
+    gt.twist.angular = {0, 0, truth.yaw_rate};
+    const io::Bytes gt_bytes = io::encodeOdometry(gt);
+    bag.write("/ground_truth/odom", at(t), gt_bytes.data(), gt_bytes.size());
+    if (k % 2 == 0) {  // 50 Hz odometry, logged 2 ms after sensing
+      const sim::OdometrySample o = sim::measureOdometry(truth, odometry_noise, rng);
+      io::StampedTwist tw;
+      tw.header = {at(t), "base_link"};
+      tw.measurement.linear = {o.speed, 0, 0};
+      tw.measurement.angular = {0, 0, o.yaw_rate};
+      tw.measurement.covariance = Matrix6d::Zero();
+      tw.measurement.covariance.diagonal() << 0.04, kInfinity, kInfinity, kInfinity, kInfinity, 0.01;
+      const io::Bytes b = io::encodeTwistWithCovarianceStamped(tw);
+      bag.write("/vehicle/twist", at(t) + 2'000'000, b.data(), b.size());
+    }
+    if (k % 10 != 0) continue;
+    // 10 Hz: a roof sweep, and each RSU's frame.
+    const auto c0 = Clock::now();
+    const auto sweep = sim::scanSweep(roof, scene, [&](double dt) { return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height); }, rng);
+    summary.ray_casting_seconds += since(c0);
+    summary.rays += raysPerSweep(roof);
+    const io::Bytes b = io::encodePointCloud2(toPointCloud2(sweep, at(t)));
+    bag.write("/points", at(t + 0.1) + 5'000'000, b.data(), b.size());  // the sweep ends, the driver publishes
+    ++summary.scans;
+    // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
+    const double capture = t + 0.05;
+    const sim::VehicleState seen = drive.at(capture);
+    with_vehicle.updateMesh(body_mesh, body.mesh(seen.position.x(), seen.position.y(), seen.yaw));
+    with_vehicle.commit();
+    for (Rsu& r : rsus) {
+      const double distance = (seen.position - r.info.position).norm();
+      if (distance > r.range) continue;
+      const Eigen::Isometry3d pose = Eigen::Translation3d(r.info.position.x(), r.info.position.y(), r.info.height) *
+                                     Eigen::AngleAxisd(r.info.yaw, Eigen::Vector3d::UnitZ());
+      const auto c1 = Clock::now();
+      std::vector<Eigen::Vector3f> frame;
+      for (const auto& p : sim::scanSweep(r.lidar, with_vehicle, [&](double) { return pose; }, rng)) frame.push_back(p.position);
+      summary.ray_casting_seconds += since(c1);
+      summary.rays += raysPerSweep(r.lidar);
+      // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
+      std::normal_distribution<double> cam(0.0, 0.3);
+      const Eigen::Vector2d reference = seen.position + Eigen::Vector2d(cam(rng), cam(rng));
+      sim::VehicleDetection d;
+      for (std::size_t v = 0; v < r.perception.size(); ++v) {
+        const sim::VehicleDetection dv = r.perception[v].detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
+        if (v == 0) {
+          d = dv;
+          summary.perception_seconds += d.processing_ms * 1e-3;
+        }
+        const double e = dv.found ? (dv.position - seen.position).norm() : std::nan("");
+        ablation_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << ","
+                     << kVariants[v].name << "," << (dv.found ? 1 : 0) << "," << e << "\n";
+        if (dv.found) {
+          auto& series = variant_errors[{r.info.id + " (" + r.info.lidar_model + ")", v}];
+          series.first.push_back(distance);
+          series.second.push_back(e);
+        }
+      }
+      if (!d.found) continue;
+      const Stamp ready = at(capture + 0.05 + options.rsu_processing);  // end of the sweep + processing
+      const std::optional<Stamp> delivered = r.link.transmit(ready);
+      const Eigen::Vector2d error = d.position - seen.position;
+      fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","
+                << error.y() << "," << error.norm() << "," << d.processing_ms << "," << (delivered ? 1 : 0) << "\n";
+      PlotSeries& series = fix_errors[r.info.id];
+      series.label = r.info.id + " (" + r.info.lidar_model + ")";
+      series.points = true;
+      series.x.push_back(distance);
+      series.y.push_back(error.norm());
+      if (!delivered) {
+        ++summary.fixes_lost;
+        continue;
+      }
+      io::StampedPose fix;
+      fix.header = {at(capture), "map"};
+      fix.measurement.pose.position = {d.position.x(), d.position.y(), 0.0};
+      fix.measurement.covariance = Matrix6d::Zero();
+      fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;
+      const io::Bytes fb = io::encodePoseWithCovarianceStamped(fix);
+      bag.write(rsuFixTopic(r.info.id), *delivered, fb.data(), fb.size());
+      ++summary.fixes;
+    }
+  }
+  if (options.progress) options.progress(1.0);
+  bag.close();
+  if (!fix_errors.empty()) {
+    Plot plot;
+    plot.title = "RSU fix error against distance from the RSU: " + scenario.name;
+    plot.x_label = "distance from the RSU [m]";
+    plot.y_label = "fix error [m]";
+    plot.y_from_zero = true;
+    for (auto& [id, series] : fix_errors) plot.series.push_back(series);
+    writeSvg(out_dir + "/rsu_fix_error.svg", plot);
+  }
+  if (!variant_errors.empty()) {
+    Plot plot;
+    plot.title = "What each perception step buys: mean fix error per 5 m, " + scenario.name;
+    plot.x_label = "distance from the RSU [m]";
+    plot.y_label = "mean fix error [m]";
+    plot.y_from_zero = true;
+    for (const auto& [key, xy] : variant_errors)
+      plot.series.push_back(binnedMean(key.first + ": " + kVariants[key.second].name, xy.first, xy.second, 5.0));
+    writeSvg(out_dir + "/rsu_perception.svg", plot);
+  }
+  // 5. How to replay it: NDT needs a first guess; the twin knows where the drive starts.
+  std::ofstream fuse(out_dir + "/fuse.yaml");
+  fuse << "# coloc fuse " << out_dir << "/log --map " << summary.map_dir << " --config " << out_dir << "/fuse.yaml\n"
+       << "replay:\n  initial_pose: [" << scenario.route_start.x() << ", " << scenario.route_start.y() << ", 0.0, " << scenario.route_heading
+       << "]\nndt:\n  lidar_pose: [0.0, 0.0, " << scenario.vehicle_lidar_height << ", 0.0, 0.0, 0.0]\n";
+  summary.drive_seconds = drive.duration();
+  summary.wall_seconds = since(wall_start);
+  return summary;
+}
+
+}  // namespace coloc::tools
