@@ -81,6 +81,9 @@ bool waitFor(const std::atomic<int>& matched, int count, std::chrono::millisecon
 
 struct FixSubscriber::Impl : public dds::DataReaderListener {
   dds::DomainParticipant* participant = nullptr;
+  // Here rather than in the owner's destructor: a constructor that fails after creating the
+  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
+  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
   std::vector<std::pair<dds::DataReader*, std::string>> readers;  ///< reader and its RSU id
   Callback callback;
@@ -131,11 +134,14 @@ FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::str
   }
 }
 
-FixSubscriber::~FixSubscriber() { destroyParticipant(impl_->participant); }
+FixSubscriber::~FixSubscriber() = default;
 int FixSubscriber::matchedPublishers() const { return impl_->matched.load(); }
 
 struct FixPublisher::Impl {
   dds::DomainParticipant* participant = nullptr;
+  // Here rather than in the owner's destructor: a constructor that fails after creating the
+  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
+  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
   dds::DataWriter* writer = nullptr;
   MatchCounter listener;
@@ -150,7 +156,7 @@ FixPublisher::FixPublisher(const DdsConfig& config, const std::string& rsu_id) :
   if (!impl_->writer) throw Error("DDS: cannot publish on " + ddsTopicName(fixTopic(rsu_id)) + " (not permitted?)");
 }
 
-FixPublisher::~FixPublisher() { destroyParticipant(impl_->participant); }
+FixPublisher::~FixPublisher() = default;
 
 void FixPublisher::publish(const RsuFix& fix, double variance) {
   RosPose msg;
@@ -176,6 +182,9 @@ bool FixPublisher::waitForSubscribers(int count, std::chrono::milliseconds timeo
 
 struct DimensionsPublisher::Impl {
   dds::DomainParticipant* participant = nullptr;
+  // Here rather than in the owner's destructor: a constructor that fails after creating the
+  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
+  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
   dds::DataWriter* writer = nullptr;
   MatchCounter listener;
@@ -189,7 +198,7 @@ DimensionsPublisher::DimensionsPublisher(const DdsConfig& config) : impl_(std::m
   if (!impl_->writer) throw Error(std::string("DDS: cannot publish on ") + ddsTopicName(kVehicleDimensionsTopic));
 }
 
-DimensionsPublisher::~DimensionsPublisher() { destroyParticipant(impl_->participant); }
+DimensionsPublisher::~DimensionsPublisher() = default;
 
 void DimensionsPublisher::publish(const VehicleDimensions& d) {
   RosDimensions msg;
@@ -208,6 +217,9 @@ bool DimensionsPublisher::waitForSubscribers(int count, std::chrono::millisecond
 
 struct DimensionsSubscriber::Impl : public dds::DataReaderListener {
   dds::DomainParticipant* participant = nullptr;
+  // Here rather than in the owner's destructor: a constructor that fails after creating the
+  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
+  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
   Callback callback;
   std::atomic<int> matched{0};
@@ -234,7 +246,7 @@ DimensionsSubscriber::DimensionsSubscriber(const DdsConfig& config, Callback cal
     throw Error(std::string("DDS: cannot subscribe to ") + ddsTopicName(kVehicleDimensionsTopic));
 }
 
-DimensionsSubscriber::~DimensionsSubscriber() { destroyParticipant(impl_->participant); }
+DimensionsSubscriber::~DimensionsSubscriber() = default;
 int DimensionsSubscriber::matchedPublishers() const { return impl_->matched.load(); }
 
 }  // namespace coloc::rsu_client

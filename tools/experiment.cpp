@@ -7,6 +7,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -215,44 +216,65 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   }
   std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU topic -> variance
 
-  for (std::size_t d = 0; d < drives.size(); ++d) {
+  // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
+  struct Recorded {
+    sim::Scenario scenario;
+    std::string name, variant;
+    TwinRecordingOptions options;
+    TwinRecordingSummary summary;
+    double seconds = 0.0;
+  };
+  auto record = [&](std::size_t d) {
     const Drive& drive = drives[d];
-    sim::Scenario scenario = scenarios[drive.site];
-    scenario.seed += 1000 * static_cast<std::uint64_t>(drive.trial);  // trial 0 is the scenario as written
-    std::string name = scenario.name + "/trial_" + std::to_string(drive.trial);
-    std::string variant;
+    Recorded r;
+    r.scenario = scenarios[drive.site];
+    r.scenario.seed += 1000 * static_cast<std::uint64_t>(drive.trial);  // trial 0 is the scenario as written
+    r.name = r.scenario.name + "/trial_" + std::to_string(drive.trial);
     char buf[64];
     if (drive.variant == "RSU height") {
-      for (sim::ScenarioRsu& r : scenario.rsus) r.height = drive.rsu_height;
+      for (sim::ScenarioRsu& rsu : r.scenario.rsus) rsu.height = drive.rsu_height;
       std::snprintf(buf, sizeof buf, "RSU height %.1f m", drive.rsu_height);
-      variant = buf;
+      r.variant = buf;
       std::snprintf(buf, sizeof buf, "_height_%.1f", drive.rsu_height);
-      name += buf;
+      r.name += buf;
     } else if (drive.variant == "speed") {
-      scenario.speed.cruise = drive.speed;
+      r.scenario.speed.cruise = drive.speed;
       std::snprintf(buf, sizeof buf, "speed %.0f m/s", drive.speed);
-      variant = buf;
+      r.variant = buf;
       std::snprintf(buf, sizeof buf, "_speed_%.0f", drive.speed);
-      name += buf;
+      r.name += buf;
     }
-    // The drive.
     const auto t0 = Clock::now();
-    TwinRecordingOptions rec;
-    rec.out_dir = results.work_dir + "/" + name;
-    fs::remove_all(rec.out_dir);
-    rec.map_dir = maps[drive.site];
-    rec.perception_ablation = drive.trial == 0 && drive.variant.empty();
-    const TwinRecordingSummary summary = recordTwin(scenario, rec);
+    r.options.out_dir = results.work_dir + "/" + r.name;
+    fs::remove_all(r.options.out_dir);
+    r.options.map_dir = maps[drive.site];
+    r.options.perception_ablation = drive.trial == 0 && drive.variant.empty();
+    r.summary = recordTwin(r.scenario, r.options);
+    r.seconds = since(t0);
+    return r;
+  };
+  // The first drive of a site surveys its map, which the site's later drives share; it has been
+  // recorded (and its map noted) before any of them starts.
+  std::future<Recorded> next = std::async(std::launch::async, record, 0);
+  for (std::size_t d = 0; d < drives.size(); ++d) {
+    const Drive& drive = drives[d];
+    Recorded recorded = next.get();
     if (maps[drive.site].empty()) {
-      maps[drive.site] = summary.map_dir;
-      results.timing.survey += summary.map_seconds;
+      maps[drive.site] = recorded.summary.map_dir;
+      results.timing.survey += recorded.summary.map_seconds;
     }
+    if (d + 1 < drives.size()) next = std::async(std::launch::async, record, d + 1);
+    const sim::Scenario& scenario = recorded.scenario;
+    const std::string& name = recorded.name;
+    const std::string& variant = recorded.variant;
+    const TwinRecordingOptions& rec = recorded.options;
+    const TwinRecordingSummary& summary = recorded.summary;
     results.timing.simulation += summary.wall_seconds - summary.map_seconds;
     results.timing.ray_casting += summary.ray_casting_seconds;
     results.timing.perception += summary.perception_seconds;
     results.timing.rays += summary.rays;
     results.timing.driven_seconds += summary.drive_seconds;
-    const double simulated_in = since(t0);
+    const double simulated_in = recorded.seconds;
 
     // Its replays.
     FuseConfig fuse = base;
@@ -300,7 +322,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       for (const std::string& lidar : config.lidars) {
         for (double delay : config.delays)
           for (double loss : config.losses)
-            if ((delay == 0.0 && loss == 0.0) || config.network) jobs.push_back(makeJob(lidar, delay, loss, "", std::nullopt));
+            if ((delay == 0.0 && loss == 0.0) || (config.network && drive.trial < config.network_trials)) jobs.push_back(makeJob(lidar, delay, loss, "", std::nullopt));
       }
       if (config.sweeps && drive.trial < config.sweep_trials) {
         for (const sim::ScenarioRsu& r : scenario.rsus) {

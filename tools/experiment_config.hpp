@@ -18,6 +18,9 @@ struct ExperimentConfig {
   std::vector<double> delays = {0.0, 0.010, 0.030};  ///< s
   std::vector<double> losses = {0.0, 0.10, 0.20};    ///< probability
   bool network = true;                               ///< run the grid at all
+  /// The grid runs on the first this many trials of each site: it is 16 replays per drive against
+  /// Table I's 3, and what it measures (change against the ideal network) is paired within a trial.
+  int network_trials = 3;
   double bin_length = 2.0;      ///< m of road per bin of the paper's metric (minimum error per bin)
   std::string fuse_config;      ///< optional fuse YAML applied to every replay (fusion, ndt, replay keys)
   int jobs = 2;                 ///< replays run side by side (each NDT on one thread)

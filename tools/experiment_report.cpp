@@ -179,7 +179,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         int n = 0;
         std::uint64_t l = 0;
         for (const SiteInfo& site : results.sites)
-          for (int t = 0; t < c.trials; ++t)
+          for (int t = 0; t < std::min(c.trials, c.network_trials); ++t)  // every cell on the same drives
             if (const ExperimentRun* r = find(results.runs, site.name, t, lidar, delay, loss, "")) {
               const ErrorInCoverage e = errorInCoverage(*r, range, bin);
               sum += e.paper, sum_plain += e.plain, l += r->fixes_lost, ++n;
@@ -322,7 +322,9 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << "Spread: standard deviation over trials; the improvement's range is over trials.\n\n"
      << "## Table I: error within coverage\n\n"
      << table1.str() << "\n";
-  if (c.network) md << "## Tables II and III: network delay and packet loss\n" << network_md.str() << "\n![network](network.svg)\n\n";
+  if (c.network)
+    md << "## Tables II and III: network delay and packet loss\n\nMean over both sites and the first " << std::min(c.trials, c.network_trials)
+       << " trial(s) of each; every cell replays the same drives.\n" << network_md.str() << "\n![network](network.svg)\n\n";
   md << "## Figures\n\n";
   for (const SiteInfo& site : results.sites)
     md << "![" << site.name << "](fig4_error_along_road_" << site.name << ".svg)\n![" << site.name << " trials](fig5_trials_" << site.name

@@ -103,6 +103,8 @@ void addRsuListenCommand(CLI::App& app) {
     std::mutex mutex;
     std::atomic<int> received{0};
     std::atomic<std::int64_t> last_fix{0};  // steady-clock ns of the newest fix
+    TeardownWatchdog watchdog("rsu-listen");
+    watchdog.arm(1);  // a participant that fails to come up is deleted at once
     rsu_client::FixSubscriber subscriber(config, ids, [&](const rsu_client::RsuFix& fix, Stamp now) {
       std::lock_guard<std::mutex> lock(mutex);
       const rsu_client::FixVerdict v = checker.check(fix, now);
@@ -117,7 +119,8 @@ void addRsuListenCommand(CLI::App& app) {
     });
     std::unique_ptr<rsu_client::DimensionsPublisher> dims;
     if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
-    const TeardownWatchdog watchdog("rsu-listen");
+    watchdog.disarm();
+    const TeardownWatchdog::ArmOnExit arm_on_exit(watchdog);
     std::printf("listening on %zu RSU topics (%s), domain %d\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
                 config.domain);
     std::fflush(stdout);
@@ -182,6 +185,8 @@ void addRsuPublishCommand(CLI::App& app) {
     if (fixes.empty()) throw Error("rsu-publish: nothing to send (give --from or --generate)");
     const rsu_client::DdsConfig config = ddsConfig(dds, rsu);
     printSecurity(config);
+    TeardownWatchdog watchdog("rsu-publish");
+    watchdog.arm(1);  // a participant that fails to come up is deleted at once
     rsu_client::FixPublisher publisher(config, rsu);
     std::mutex print;
     std::atomic<bool> have_dimensions{false};
@@ -194,7 +199,8 @@ void addRsuPublishCommand(CLI::App& app) {
                     d.reference_x, d.reference_y);
         std::fflush(stdout);
       });
-    const TeardownWatchdog watchdog("rsu-publish");
+    watchdog.disarm();
+    const TeardownWatchdog::ArmOnExit arm_on_exit(watchdog);
     if (wait_subscribers > 0 &&
         !publisher.waitForSubscribers(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000))))
       throw Error("rsu-publish: no listener matched within " + std::to_string(wait_timeout) + " s");

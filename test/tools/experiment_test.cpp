@@ -1,0 +1,86 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "builtin_scenarios.hpp"
+#include "coloc/core/error.hpp"
+#include "coloc/sim/scene.hpp"
+#include "experiment_config.hpp"
+#include "experiment_report.hpp"
+
+namespace coloc::tools {
+namespace {
+
+std::string errorOf(const std::string& yaml) {
+  try {
+    parseExperimentConfig(yaml, "exp.yaml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
+  const ExperimentConfig c = parseExperimentConfig("", "exp.yaml");
+  EXPECT_EQ(c.sites, (std::vector<std::string>{"site_a", "site_b"}));
+  EXPECT_EQ(c.trials, 10);
+  EXPECT_EQ(c.lidars, (std::vector<std::string>{"VLP-16", "VLP-32C"}));
+  EXPECT_EQ(c.delays, (std::vector<double>{0.0, 0.010, 0.030}));
+  EXPECT_EQ(c.losses, (std::vector<double>{0.0, 0.10, 0.20}));
+  EXPECT_DOUBLE_EQ(c.bin_length, 2.0);
+  EXPECT_EQ(quickExperiment(c).trials, 1);
+}
+
+TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
+  EXPECT_EQ(errorOf("trials: 3\ntrails: 4\n").rfind("exp.yaml:2: trails: unknown key", 0), 0u) << errorOf("trails: 4");
+  EXPECT_NE(errorOf("trials: 0\n").find("exp.yaml:1: trials: must be in [1, 1000]"), std::string::npos);
+  EXPECT_NE(errorOf("lidars: [VLP-64]\n").find("unknown LiDAR model 'VLP-64'"), std::string::npos);
+  EXPECT_NE(errorOf("losses: [0.0, .nan]\n").find("losses: must be in"), std::string::npos);
+  EXPECT_NE(errorOf("delays: [0.01, 0.03]\n").find("the ideal network is the reference"), std::string::npos);
+  EXPECT_NE(errorOf("- a list\n").find("expected a mapping"), std::string::npos);
+}
+
+TEST(ExperimentConfig, BuiltInScenariosAreTheShippedFiles) {
+  for (const char* name : {"site_a", "site_b"}) {
+    std::ifstream in(std::string(COLOC_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
+    std::ostringstream text;
+    text << in.rdbuf();
+    ASSERT_NE(builtinScenario(name), nullptr) << name;
+    EXPECT_EQ(text.str(), builtinScenario(name));
+    EXPECT_EQ(sim::parseScenario(scenarioText(name), name).name, name);
+  }
+  EXPECT_EQ(builtinScenario("site_z"), nullptr);
+  EXPECT_THROW(scenarioText("site_z"), Error);
+}
+
+// A run along 10 m of road, 4 samples per metre; the error is 0.1 m except one 0.5 m sample per 2 m bin.
+ExperimentRun syntheticRun() {
+  ExperimentRun r;
+  for (int i = 0; i < 40; ++i) {
+    r.along.push_back(i * 0.25);
+    r.to_rsu.push_back(std::abs(i * 0.25 - 5.0));  // the RSU stands at 5 m
+    r.error.push_back(i % 8 == 3 ? 0.5 : 0.1 + 0.01 * (i / 8));
+  }
+  return r;
+}
+
+TEST(ErrorInCoverage, PaperMetricIsTheMeanOfEachBinsMinimumAndIgnoresTheRestOfTheRoad) {
+  const ExperimentRun r = syntheticRun();
+  // Everything in range: bins of 2 m hold samples 0-7, 8-15, ...; minima 0.10, 0.11, 0.12, 0.13, 0.14.
+  const ErrorInCoverage all = errorInCoverage(r, 100.0, 2.0);
+  EXPECT_NEAR(all.paper, 0.12, 1e-12);
+  EXPECT_EQ(all.samples, 40u);
+  double plain = 0.0;
+  for (double e : r.error) plain += e;
+  EXPECT_NEAR(all.plain, plain / 40, 1e-12);
+  EXPECT_GT(all.plain, all.paper);  // the outliers count in the plain mean only
+  // Within 1 m of the RSU (4 to 6 m along): bins [4, 6) with minimum 0.12, [6, 8) holds only the 6 m sample (0.13).
+  const ErrorInCoverage near = errorInCoverage(r, 1.0, 2.0);
+  EXPECT_EQ(near.samples, 9u);
+  EXPECT_NEAR(near.paper, 0.5 * (0.12 + 0.13), 1e-12);
+  EXPECT_EQ(errorInCoverage(r, -1.0, 2.0).samples, 0u);
+}
+
+}  // namespace
+}  // namespace coloc::tools
