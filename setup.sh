@@ -25,6 +25,6 @@ fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
 
-if [ -x build/tools/coloc ]; then
-  build/tools/coloc fuse ../shared/data/real/rosbag2/nav2_turtlebot.mcap --out results/nav2_turtlebot
-fi
+# The main job on built-in defaults: the paper's experiment on the digital twin, one trial of each
+# configuration (`coloc experiment` without --quick runs the full ten trials).
+build/tools/coloc experiment --quick --out results/experiment

@@ -5,6 +5,7 @@
 // pose as NDT's initial guess as on a vehicle. The configurations of a trial share the drive and the
 // scans, so their comparison is paired.
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,8 @@ struct ExperimentResults {
   std::vector<SiteInfo> sites;
   std::vector<ExperimentRun> runs;
   ExperimentTiming timing;
+  /// "SITE LIDAR" -> the fixes' variance estimated on the site's first drive, m^2 (when used).
+  std::map<std::string, double> estimated_variance;
   std::string work_dir;  ///< the recordings
 };
 

@@ -71,6 +71,15 @@ struct Reader {
 
 }  // namespace
 
+const char* toString(RsuCovariance c) {
+  switch (c) {
+    case RsuCovariance::kPublished: return "published";
+    case RsuCovariance::kStandardDeviation: return "standard_deviation";
+    case RsuCovariance::kEstimated: return "estimated";
+  }
+  return "?";
+}
+
 ExperimentConfig quickExperiment(ExperimentConfig config) {
   config.trials = 1;
   config.sweep_trials = 1;
@@ -101,7 +110,13 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     } else if (key == "delays") c.delays = r.numbers(v, key, 0.0, 1.0);
     else if (key == "losses") c.losses = r.numbers(v, key, 0.0, 0.99);
     else if (key == "network") c.network = r.flag(v, key);
-    else if (key == "network_trials") c.network_trials = r.integer(v, key, 1, 1000);
+    else if (key == "rsu_covariance") {
+      const std::string t = r.text(v, key);
+      if (t == "published") c.rsu_covariance = RsuCovariance::kPublished;
+      else if (t == "standard_deviation") c.rsu_covariance = RsuCovariance::kStandardDeviation;
+      else if (t == "estimated") c.rsu_covariance = RsuCovariance::kEstimated;
+      else r.fail(v, key, "expected published, standard_deviation or estimated");
+    } else if (key == "network_trials") c.network_trials = r.integer(v, key, 1, 1000);
     else if (key == "bin_length") c.bin_length = r.number(v, key, 0.1, 100.0);
     else if (key == "fuse_config") c.fuse_config = r.text(v, key);
     else if (key == "jobs") c.jobs = r.integer(v, key, 1, 64);
@@ -109,7 +124,7 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     else if (key == "sweep_trials") c.sweep_trials = r.integer(v, key, 1, 1000);
     else if (key == "rsu_heights") c.rsu_heights = r.numbers(v, key, 0.5, 20.0);
     else if (key == "speeds") c.speeds = r.numbers(v, key, 1.0, 40.0);
-    else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, bin_length, fuse_config, jobs, sweeps, "
+    else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, bin_length, fuse_config, jobs, sweeps, "
                                   "sweep_trials, rsu_heights, speeds)");
   }
   if (c.delays.front() != 0.0 || c.losses.front() != 0.0)

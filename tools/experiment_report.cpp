@@ -301,7 +301,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
           }
         if (fused_v.empty()) continue;
         const Spread n = spread(ndt_v), f = spread(fused_v), fp = spread(fused_plain);
-        const std::string name = variant.empty() ? "as in the paper (covariance as published, RSU at 2 m, 10 m/s)" : variant;
+        const std::string name =
+            variant.empty() ? std::string("main experiment (covariance ") + toString(c.rsu_covariance) + ", RSU at 2 m, 10 m/s)" : variant;
         sweeps_md << "| " << name << " | " << lidar << " | " << cm(n) << " | " << cm(f) << " | " << fmt("%.0f %%", improvement(n.mean, f.mean))
                   << " | " << cm(fp) << " |\n";
         sweeps_csv << "\"" << name << "\"," << lidar << "," << f.n << "," << n.mean << "," << f.mean << "," << improvement(n.mean, f.mean) << ","
@@ -314,7 +315,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   const ExperimentTiming& tm = results.timing;
   md << "# coloc experiment: cooperative localization on the digital twin\n\n"
      << "`" << command_line << "`\n\n"
-     << c.trials << " trial(s) per site; sites: ";
+     << c.trials << " trial(s) per site; RSU fix covariance " << toString(c.rsu_covariance) << "; sites: ";
   for (std::size_t i = 0; i < results.sites.size(); ++i) md << (i ? ", " : "") << results.sites[i].name;
   md << ". Errors are planar, against ground truth, where the vehicle is within the roadside LiDAR's coverage. "
      << "\"NDT only\" is the same drive and scans without the RSU's fixes. The paper's metric is the minimum error in each "
@@ -330,6 +331,15 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     md << "![" << site.name << "](fig4_error_along_road_" << site.name << ".svg)\n![" << site.name << " trials](fig5_trials_" << site.name
        << ".svg)\n\n";
   if (c.sweeps) md << "## Sweeps beyond the paper (" << std::min(c.sweep_trials, c.trials) << " trial(s) per site, both sites pooled)\n\n" << sweeps_md.str() << "\n";
+  if (!results.estimated_variance.empty()) {
+    md << "Fix variances estimated on each site's first drive (robust, from the median absolute error per axis): ";
+    bool first = true;
+    for (const auto& [key, v] : results.estimated_variance) {
+      md << (first ? "" : ", ") << key << fmt(" %.2e m^2", v) << fmt(" (sigma %.1f cm)", 100 * std::sqrt(v));
+      first = false;
+    }
+    md << ".\n\n";
+  }
   md << "## Run time\n\n"
      << fmt("%.0f s in all", tm.total) << fmt(": survey maps %.1f s, ", tm.survey) << fmt("simulating %.0f s of driving ", tm.driven_seconds) << fmt("%.1f s ", tm.simulation)
      << fmt("(ray casting %.1f s at ", tm.ray_casting) << fmt("%.1f M rays/s, ", tm.rays / std::max(tm.ray_casting, 1e-9) * 1e-6)

@@ -39,6 +39,9 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_NE(errorOf("losses: [0.0, .nan]\n").find("losses: must be in"), std::string::npos);
   EXPECT_NE(errorOf("delays: [0.01, 0.03]\n").find("the ideal network is the reference"), std::string::npos);
   EXPECT_NE(errorOf("- a list\n").find("expected a mapping"), std::string::npos);
+  EXPECT_NE(errorOf("rsu_covariance: guessed\n").find("exp.yaml:1: rsu_covariance: expected published, standard_deviation or estimated"),
+            std::string::npos);
+  EXPECT_EQ(parseExperimentConfig("rsu_covariance: estimated\n", "exp.yaml").rsu_covariance, RsuCovariance::kEstimated);
 }
 
 TEST(ExperimentConfig, BuiltInScenariosAreTheShippedFiles) {
