@@ -76,8 +76,11 @@ RsuInfo readRsu(const std::string& source, const YAML::Node& node, std::size_t i
       if (*radius <= 0.0) fail(source, entry.second, full, "must be > 0 m");
     } else if (key == "identity") {
       rsu.identity = text(source, entry.second, full);
+    } else if (key == "calibrated_variance") {
+      rsu.calibrated_variance = number(source, entry.second, full);
+      if (*rsu.calibrated_variance <= 0.0) fail(source, entry.second, full, "must be > 0 m^2");
     } else {
-      fail(source, entry.first, full, "unknown key (id, position, height, lidar_model, coverage_radius, identity)");
+      fail(source, entry.first, full, "unknown key (id, position, height, lidar_model, coverage_radius, identity, calibrated_variance)");
     }
   }
   if (rsu.id.empty()) fail(source, node, where, "needs an id");
@@ -139,6 +142,7 @@ const RsuInfo* RsuRegistry::find(const std::string& id) const {
 }
 
 double RsuRegistry::variance(const RsuInfo& rsu) const {
+  if (rsu.calibrated_variance) return *rsu.calibrated_variance;
   return placement_ == CovariancePlacement::kPublished ? rsu.lidar.sigma : rsu.lidar.sigma * rsu.lidar.sigma;
 }
 

@@ -345,10 +345,15 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
             if ((delay == 0.0 && loss == 0.0) || (config.network && drive.trial < config.network_trials))
               jobs.push_back(makeJob(lidar, delay, loss, "", varianceFor(main_covariance, lidar)));
       }
-      if (config.sweeps && drive.trial < config.sweep_trials)
-        for (const std::string& lidar : config.lidars)
+      // Table I compares with a second covariance on every trial; the sweeps add the third.
+      const RsuCovariance reference = referenceCovariance(main_covariance);
+      for (const std::string& lidar : config.lidars) {
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(reference), varianceFor(reference, lidar)));
+        if (config.sweeps && drive.trial < config.sweep_trials)
           for (RsuCovariance how : {RsuCovariance::kPublished, RsuCovariance::kStandardDeviation, RsuCovariance::kEstimated})
-            if (how != main_covariance) jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(how), varianceFor(how, lidar)));
+            if (how != main_covariance && how != reference)
+              jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(how), varianceFor(how, lidar)));
+      }
     } else {
       if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
       for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));

@@ -80,6 +80,10 @@ const char* toString(RsuCovariance c) {
   return "?";
 }
 
+RsuCovariance referenceCovariance(RsuCovariance main) {
+  return main == RsuCovariance::kPublished ? RsuCovariance::kEstimated : RsuCovariance::kPublished;
+}
+
 ExperimentConfig quickExperiment(ExperimentConfig config) {
   config.trials = 1;
   config.sweep_trials = 1;

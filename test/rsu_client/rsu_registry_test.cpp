@@ -33,6 +33,17 @@ TEST(RsuRegistry, StandardDeviationPlacementSquaresTheSigma) {
   EXPECT_DOUBLE_EQ(r.variance(*r.find("a")), 0.00681 * 0.00681);
 }
 
+TEST(RsuRegistry, CalibratedVarianceOverridesTheModelsFigureWhateverThePlacement) {
+  for (const char* placement : {"published", "standard_deviation"}) {
+    const RsuRegistry r = RsuRegistry::parse(std::string("covariance_placement: ") + placement +
+                                                 "\nrsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.0016}\n"
+                                                 "  - {id: b, position: [9, 0], lidar_model: VLP-16}\n",
+                                             "rsu.yaml");
+    EXPECT_DOUBLE_EQ(r.variance(*r.find("a")), 0.0016) << placement;
+    EXPECT_DOUBLE_EQ(r.variance(*r.find("b")), placement[0] == 'p' ? 0.01486 : 0.01486 * 0.01486) << placement;
+  }
+}
+
 TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: HDL-64}\n", "unknown LiDAR model 'HDL-64'");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16}\n  - {id: a, position: [1, 0], lidar_model: VLP-16}\n",
@@ -43,6 +54,9 @@ TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, coverage_radius: -3}\n", "must be > 0");
   expectError("rsus:\n  - {id: a/b, position: [0, 0], lidar_model: VLP-16}\n", "DDS topic");
   expectError("covariance_placement: guessed\n", "expected published or standard_deviation");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0}\n",
+              "rsus[0].calibrated_variance: must be > 0");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: .nan}\n", "must be finite");
   expectError("rsu:\n  - {}\n", "rsu: unknown key");
 }
 

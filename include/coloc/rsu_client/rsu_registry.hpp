@@ -31,6 +31,9 @@ struct RsuInfo {
   LidarModel lidar;
   double coverage_radius = 0.0;  ///< m; fixes farther than this from the RSU are refused
   std::string identity;          ///< subject of its DDS Security certificate, e.g. "CN=rsu_a"
+  /// x/y variance measured for this RSU (m^2), e.g. by driving a surveyed vehicle past it; when set,
+  /// its fixes carry it instead of the model's figure, whatever the placement.
+  std::optional<double> calibrated_variance;
 };
 
 class RsuRegistry {
@@ -43,7 +46,8 @@ class RsuRegistry {
   const RsuInfo* find(const std::string& id) const;
   const std::vector<RsuInfo>& rsus() const { return rsus_; }
   CovariancePlacement placement() const { return placement_; }
-  /// The x/y variance a fix from this RSU carries.
+  /// The x/y variance a fix from this RSU carries: its calibrated variance, else the model's figure
+  /// placed as the registry says.
   double variance(const RsuInfo& rsu) const;
 
  private:
