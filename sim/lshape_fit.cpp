@@ -40,6 +40,25 @@ double score(const std::vector<double>& c1, const std::vector<double>& c2, const
   return config.criterion == LShapeCriterion::kCloseness ? closeness : -variance(e1) - variance(e2);
 }
 
+// Where an edge lies: the outermost projection, or the median of the points within `band` of it if
+// they spread at least `min_spread` along the edge (`along` are the same points' other projection).
+double edgeOffset(const std::vector<double>& across, const std::vector<double>& along, double extreme, double band) {
+  constexpr double kMinSpread = 0.3;  // m: a face, not the end of the perpendicular one
+  constexpr std::size_t kMinPoints = 5;
+  if (band <= 0.0) return extreme;
+  std::vector<double> near;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < across.size(); ++i)
+    if (std::abs(across[i] - extreme) <= band) {
+      near.push_back(across[i]);
+      lo = std::min(lo, along[i]);
+      hi = std::max(hi, along[i]);
+    }
+  if (near.size() < kMinPoints || hi - lo < kMinSpread) return extreme;
+  std::nth_element(near.begin(), near.begin() + near.size() / 2, near.end());
+  return near[near.size() / 2];
+}
+
 Eigen::Vector2d intersect(const Eigen::Vector2d& n0, double c0, const Eigen::Vector2d& n1, double c1) {
   const double det = n0.x() * n1.y() - n1.x() * n0.y();
   return {(n1.y() * c0 - n0.y() * c1) / det, (n0.x() * c1 - n1.x() * c0) / det};
@@ -67,13 +86,14 @@ FittedRectangle fitLShape(const std::vector<Eigen::Vector2d>& points, const LSha
     }
   }
   const Eigen::Vector2d e1(std::cos(best_angle), std::sin(best_angle)), e2(-std::sin(best_angle), std::cos(best_angle));
-  double min1 = std::numeric_limits<double>::infinity(), max1 = -min1, min2 = min1, max2 = -min1;
-  for (const auto& p : points) {
-    min1 = std::min(min1, p.dot(e1));
-    max1 = std::max(max1, p.dot(e1));
-    min2 = std::min(min2, p.dot(e2));
-    max2 = std::max(max2, p.dot(e2));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    c1[i] = points[i].dot(e1);
+    c2[i] = points[i].dot(e2);
   }
+  const auto [lo1, hi1] = std::minmax_element(c1.begin(), c1.end());
+  const auto [lo2, hi2] = std::minmax_element(c2.begin(), c2.end());
+  const double min1 = edgeOffset(c1, c2, *lo1, config.edge_band), max1 = edgeOffset(c1, c2, *hi1, config.edge_band);
+  const double min2 = edgeOffset(c2, c1, *lo2, config.edge_band), max2 = edgeOffset(c2, c1, *hi2, config.edge_band);
   FittedRectangle r;
   r.angle = best_angle;
   r.corners = {intersect(e1, min1, e2, min2), intersect(e2, min2, e1, max1), intersect(e1, max1, e2, max2),

@@ -18,6 +18,10 @@ struct LShapeConfig {
   LShapeCriterion criterion = LShapeCriterion::kVariance;
   double angle_step_deg = 1.0;    ///< search resolution over [0, 90] deg, both ends included
   double closeness_floor = 0.01;  ///< m, d0 of the closeness criterion
+  /// m. Zhang et al. put each edge at the outermost point; with range noise that is the noise's
+  /// extreme, a few centimetres outside the surface. An edge whose points within this band spread
+  /// along it (a face the LiDAR sees) goes through their median instead. 0: outermost points.
+  double edge_band = 0.1;
 };
 
 struct FittedRectangle {
