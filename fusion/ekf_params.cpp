@@ -20,6 +20,8 @@ const std::vector<EkfParam>& ekfParams() {
       {"max_twist_queue_size", "twists", "as max_pose_queue_size, for twists", &C::max_twist_queue_size},
       {"pose_gate_alpha", "", "chance a correct pose is gated: d^2 = e' S^-1 e against the chi-square (1 - alpha) quantile; 0 = no gate", &C::pose_gate_alpha},
       {"twist_gate_alpha", "", "as pose_gate_alpha, for twists", &C::twist_gate_alpha},
+      {"pose_time_alignment", "", "carry a pose from its stamp to the tick it is applied at (up to half a tick) with the state's speed and yaw rate; off = Autoware's rounding", &C::pose_time_alignment},
+      {"pose_gate_recovery", "poses", "after this many gated poses of a source in a row, the next are applied at the gate's weight until one passes; 0 = off", &C::pose_gate_recovery},
       {"z_filter_proc_dev", "m/s", "random walk of the separate z filter", &C::z_filter_proc_dev},
       {"roll_filter_proc_dev", "rad/s", "random walk of the separate roll filter", &C::roll_filter_proc_dev},
       {"pitch_filter_proc_dev", "rad/s", "random walk of the separate pitch filter", &C::pitch_filter_proc_dev},

@@ -29,6 +29,7 @@ void validate(const EkfConfig& c) {
   requireConfig(c.max_pose_queue_size >= 1, "max_pose_queue_size", "must be >= 1");
   requireConfig(c.max_twist_queue_size >= 1, "max_twist_queue_size", "must be >= 1");
   requireConfig(c.pose_gate_alpha >= 0.0 && c.pose_gate_alpha < 1.0, "pose_gate_alpha", "must be in [0, 1)");
+  requireConfig(c.pose_gate_recovery >= 0, "pose_gate_recovery", "must be >= 0");
   requireConfig(c.twist_gate_alpha >= 0.0 && c.twist_gate_alpha < 1.0, "twist_gate_alpha", "must be in [0, 1)");
   const std::pair<const char*, double> non_negative[] = {
       {"proc_stddev_yaw_c", c.proc_stddev_yaw_c},       {"proc_stddev_vx_c", c.proc_stddev_vx_c},
@@ -64,6 +65,7 @@ struct Localizer::Impl {
     std::string name;
     SourceKind kind;
     SourceCounters counters;
+    int gated_in_a_row = 0;
   };
   // A measurement still being applied over its smoothing steps.
   struct Active {
@@ -167,15 +169,34 @@ struct Localizer::Impl {
   // First use of a measurement whose tick exists: gate it, then apply it (over its smoothing steps).
   Verdict firstUse(SourceId id, Stamp stamp, UpdateRecord record, int back) {
     Source& src = sources[id];
+    // A pose taken between ticks is compared with the tick's state carried to its stamp; the offset is
+    // fixed in the record, so every use and replay linearizes the same model at its own state.
+    if (src.kind == SourceKind::kPose && config.pose_time_alignment) record.time_offset = toSeconds(stamp - history.stampAt(back));
     const double d2 = mahalanobisSquared(history.stateAt(back), record);
     const auto& gate = src.kind == SourceKind::kPose ? pose_gate : twist_gate;
+    std::string note;
     if (record.m > 0 && !(d2 <= gate[record.m])) {
       std::ostringstream why;
       why << "squared Mahalanobis distance " << d2 << " exceeds the chi-square(" << record.m << ") gate "
           << gate[record.m];
-      Verdict v{Outcome::kRejected, Reason::kGated, inputKind(id), src.name, stamp, back, d2, why.str()};
-      ++src.counters.gated;
-      return report(std::move(v));
+      const bool recover = src.kind == SourceKind::kPose && config.pose_gate_recovery > 0 &&
+                           src.gated_in_a_row >= config.pose_gate_recovery && std::isfinite(d2);
+      if (!recover) {
+        ++src.gated_in_a_row;
+        Verdict v{Outcome::kRejected, Reason::kGated, inputKind(id), src.name, stamp, back, d2, why.str()};
+        ++src.counters.gated;
+        return report(std::move(v));
+      }
+      // Scale S = HPH' + R by k = d2 / gate through R alone, R' = (k - 1) HPH' + k R: the pose then sits
+      // exactly on the gate and moves the state 1/k of the way a trusted one would.
+      const double k = d2 / gate[record.m];
+      const Eigen::Matrix3d hph = innovation(history.stateAt(back), record, 1.0).S - record.R;
+      record.R = (k - 1.0) * hph + k * record.R;
+      ++src.counters.gate_recovered;
+      why << "; applied at 1/" << k << " weight (gate recovery after " << src.gated_in_a_row << " gated in a row)";
+      note = why.str();
+    } else {
+      src.gated_in_a_row = 0;
     }
     const int steps = smoothingSteps(src.kind);
     // The tick must stay in the history for all uses; fewer, heavier uses carry the same information.
@@ -193,7 +214,7 @@ struct Localizer::Impl {
       if (queued >= queueCapacity(src.kind)) fold(oldest);
       active.push_back({id, stamp, record, uses - 1, uses});
     }
-    return accept(id, stamp, Outcome::kApplied, back, d2);
+    return accept(id, stamp, Outcome::kApplied, back, d2, note);
   }
 
   FilterState initialState(const UpdateRecord& r) const {

@@ -49,16 +49,49 @@ void updateAux(ScalarFilter& filter, double value, double variance, bool angle) 
   filter.variance *= 1.0 - gain;
 }
 
+// The measurement Jacobian rows and predicted values: a selection of the state, plus, for a
+// measurement taken time_offset after its tick, the motion over that time (x, y along the heading
+// at vx; yaw at wz).
+struct Model {
+  Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
+  Eigen::Vector3d predicted = Eigen::Vector3d::Zero();
+};
+
+Model model(const FilterState& state, const UpdateRecord& record) {
+  Model out;
+  const double dt = record.time_offset, heading = state.x[kYaw] + state.x[kYawBias], vx = state.x[kVx];
+  const double c = std::cos(heading), s = std::sin(heading);
+  for (int i = 0; i < record.m; ++i) {
+    const int si = record.index[i];
+    out.H(i, si) = 1.0;
+    out.predicted[i] = state.x[si];
+    if (dt == 0.0) continue;
+    if (si == kX || si == kY) {
+      const double along = si == kX ? c : s, turn = si == kX ? -s : c;
+      out.predicted[i] += vx * along * dt;
+      out.H(i, kVx) += along * dt;
+      out.H(i, kYaw) += vx * turn * dt;
+      out.H(i, kYawBias) += vx * turn * dt;
+    } else if (si == kYaw) {
+      out.predicted[i] += state.x[kWz] * dt;
+      out.H(i, kWz) += dt;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale) {
   Innovation out;
   out.m = record.m;
+  const Model mdl = model(state, record);
+  const Eigen::Matrix<double, 3, 3> HPHt = mdl.H * state.P * mdl.H.transpose();
   for (int i = 0; i < record.m; ++i) {
     const int si = record.index[i];
-    const double residual = record.value[i] - state.x[si];
+    const double residual = record.value[i] - mdl.predicted[i];
     out.e[i] = isAngle(si) ? wrapAngle(residual) : residual;
-    for (int j = 0; j < record.m; ++j) out.S(i, j) = state.P(si, record.index[j]) + scale * record.R(i, j);
+    for (int j = 0; j < record.m; ++j) out.S(i, j) = HPHt(i, j) + scale * record.R(i, j);
   }
   return out;
 }
@@ -74,9 +107,8 @@ double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) 
 bool applyUpdate(FilterState& state, const UpdateRecord& record) {
   if (record.m > 0) {
     const Innovation in = innovation(state, record, record.scale);
-    // PHt = P H^T: the columns of P selected by the measured components.
-    Eigen::Matrix<double, 6, 3> PHt = Eigen::Matrix<double, 6, 3>::Zero();
-    for (int i = 0; i < record.m; ++i) PHt.col(i) = state.P.col(record.index[i]);
+    // PHt = P H^T (rows of H beyond m are zero).
+    const Eigen::Matrix<double, 6, 3> PHt = state.P * model(state, record).H.transpose();
     // K = PHt S^-1, computed as (S^-1 PHt^T)^T since S is symmetric.
     Eigen::Matrix<double, 3, 6> KT = Eigen::Matrix<double, 3, 6>::Zero();
     if (!solveSpd<6>(in.S, in.m, PHt.transpose(), KT)) return false;

@@ -40,7 +40,8 @@ nlohmann::ordered_json countersJson(const fusion::SourceCounters& c) {
   return {{"received", c.received},   {"applied", c.applied},         {"gated", c.gated},
           {"too_old", c.too_old},     {"from_future", c.from_future}, {"invalid", c.invalid},
           {"not_initialized", c.not_initialized}, {"numerical", c.numerical}, {"pending", c.pending},
-          {"smoothing_shortened", c.smoothing_shortened}};
+          {"smoothing_shortened", c.smoothing_shortened},
+          {"gate_recovered", c.gate_recovered}};
 }
 
 // Everything in summary.json is a function of the log and the config, so that reruns give the same

@@ -53,6 +53,60 @@ TEST(Gate, IncludesTheMeasurementCovarianceInS) {
   EXPECT_TRUE(localizer.feedPose("ndt", m).applied());
 }
 
+// A standing vehicle whose filter is sure it is at x = 0 while a precise RSU keeps saying x = 0.6: one
+// fix every 5 ticks, the odometry holding the filter's covariance small.
+struct Disagreement {
+  std::vector<Verdict> verdicts;
+  double final_x = 0.0;
+};
+Disagreement disagree(int recovery, int fixes) {
+  EkfConfig config = quietConfig();
+  config.pose_gate_recovery = recovery;
+  Localizer localizer = startedLocalizer(config);
+  localizer.initialize(planarPose(kStart, 0.0, 0.0, 0.0, 0.001, 0.0001));
+  Disagreement d;
+  for (int k = 1; k <= 5 * fixes; ++k) {
+    localizer.advanceTo(kStart + k * kTick);
+    localizer.feedTwist("odom", twist(kStart + k * kTick, 0.0, 0.0, 1e-4, 1e-4));
+    if (k % 5 == 0) d.verdicts.push_back(localizer.feedPose("rsu", fix2d(kStart + k * kTick, 0.6, 0.0, 1e-5)));
+  }
+  localizer.advanceTo(kStart + (5 * fixes + 10) * kTick);
+  d.final_x = localizer.estimate()->state[0];
+  return d;
+}
+
+TEST(Gate, WithoutRecoveryAPreciseSourceThatDisagreesIsLockedOutForGood) {
+  const Disagreement d = disagree(0, 30);
+  for (const Verdict& v : d.verdicts) EXPECT_EQ(v.reason, Reason::kGated) << v.message();
+  EXPECT_NEAR(d.final_x, 0.0, 0.01);
+}
+
+TEST(Gate, RecoveryAppliesPersistentlyGatedPosesAtTheGatesWeightUntilTheyPassOnTheirOwn) {
+  const Disagreement d = disagree(3, 30);
+  ASSERT_GE(d.verdicts.size(), 5u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(d.verdicts[i].reason, Reason::kGated) << i << ": " << d.verdicts[i].message();
+  // The fourth sits on the gate: applied, its distance over the gate, the note saying why.
+  EXPECT_TRUE(d.verdicts[3].applied()) << d.verdicts[3].message();
+  EXPECT_GT(d.verdicts[3].mahalanobis_squared, 46.0);
+  EXPECT_NE(d.verdicts[3].message().find("gate recovery after 3 gated in a row"), std::string::npos) << d.verdicts[3].message();
+  // Later ones pass on their own and the filter ends where the source says, within its precision.
+  EXPECT_TRUE(d.verdicts.back().applied());
+  EXPECT_LE(d.verdicts.back().mahalanobis_squared, 46.1);
+  EXPECT_NEAR(d.final_x, 0.6, 0.01);
+}
+
+TEST(Gate, RecoveryNeedsTheDisagreementInARow) {
+  // A single outlier between good poses is dropped as before, whatever the recovery count.
+  EkfConfig config = quietConfig();
+  config.pose_gate_recovery = 1;
+  Localizer localizer = startedLocalizer(config);
+  EXPECT_EQ(localizer.feedPose("ndt", offsetAlongX(localizer, 10.0)).reason, Reason::kGated);
+  EXPECT_TRUE(localizer.feedPose("ndt", offsetAlongX(localizer, 1.0)).applied());
+  const Snapshot before = snapshot(localizer);
+  EXPECT_EQ(localizer.feedPose("ndt", offsetAlongX(localizer, 10.0)).reason, Reason::kGated);
+  EXPECT_TRUE(snapshot(localizer) == before);
+}
+
 TEST(Gate, TwistGateRejectsAnImpossibleSpeed) {
   Localizer localizer = startedLocalizer();
   const Verdict v = localizer.feedTwist("odom", twist(kStart, 300.0, 0.0, 0.01, 0.01));

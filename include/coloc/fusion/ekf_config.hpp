@@ -28,6 +28,17 @@ struct EkfConfig {
   /// 1e-10 gives Autoware's 49.5 (3 dof) and 46.1 (2 dof), now applied to the squared distance. 0 = off.
   double pose_gate_alpha = 1e-10;
   double twist_gate_alpha = 1e-10;
+  /// After this many poses of one source in a row failed the gate, the next ones are applied at reduced
+  /// weight (their innovation covariance scaled up to the gate) until one passes on its own: when a
+  /// source keeps disagreeing, the filter is more likely to have drifted with a covariance too small for
+  /// its error (biased NDT) than the source to fail every time, and a hard gate would lock it out for
+  /// good. 0 = off (Autoware: a gated pose is dropped, always).
+  int pose_gate_recovery = 0;
+  /// A pose is applied at the tick nearest its stamp, up to half a tick (10 ms at 50 Hz) away; at
+  /// 10 m/s that is up to 10 cm along the track, the same every time when the sensor's rate and the
+  /// filter's are in step. On: the pose is first carried from its stamp to its tick with the state's
+  /// own speed and yaw rate. Off: Autoware's rounding.
+  bool pose_time_alignment = true;
 
   double z_filter_proc_dev = 5.0;      ///< m/s; random walk of the separate z filter
   double roll_filter_proc_dev = 0.1;   ///< rad/s

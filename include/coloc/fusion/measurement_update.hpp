@@ -18,6 +18,9 @@ struct UpdateRecord {
   std::array<double, 3> aux_variance{};
   /// Multiplies every covariance when applied: smoothing applies a measurement n times at n R.
   double scale = 1.0;
+  /// s; the measurement was taken this long after the tick it is applied at (negative: before). The
+  /// measurement model then carries the tick's state to that moment with its speed and yaw rate.
+  double time_offset = 0.0;
 };
 
 /// Innovation e = y - H x (angles wrapped) and its covariance S = H P H^T + R (R unscaled).

@@ -59,6 +59,8 @@ struct SourceCounters {
   /// Applied, but with fewer smoothing steps than configured because the history or the queue ran
   /// out; the measurement's full information still went in.
   std::uint64_t smoothing_shortened = 0;
+  /// Applied although over the gate, at reduced weight, by gate recovery (pose_gate_recovery).
+  std::uint64_t gate_recovered = 0;
 };
 
 }  // namespace coloc::fusion
