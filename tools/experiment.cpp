@@ -190,7 +190,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   ExperimentResults results;
   results.config = config;
   results.work_dir = out_dir + "/recordings";
-  FuseConfig base = config.fuse_config.empty() ? FuseConfig{} : loadFuseConfig(config.fuse_config);
+  FuseConfig base;
+  base.fusion.pose_gate_recovery = config.gate_recovery;
+  if (!config.fuse_config.empty()) base = loadFuseConfig(config.fuse_config);  // a full configuration: its own gate recovery
   base.ndt.source.ndt.threads = 1;  // the replays run side by side instead: small scans scale poorly over threads
 
   // The work, counted in drives; each drive is followed by its replays.

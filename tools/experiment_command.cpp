@@ -52,7 +52,7 @@ void addExperimentCommand(CLI::App& app) {
     progress.fraction = [&](double f) { done = f; };
     progress.step = [&](const std::string& line) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::printf("  %s", line.c_str());
+      std::printf("  %s [%.0f s]", line.c_str(), elapsed);
       if (done > 0.0 && done < 1.0) std::printf(" (about %.0f s left)", elapsed * (1.0 - done) / done);
       std::printf("\n");
       std::fflush(stdout);

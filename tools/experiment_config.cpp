@@ -121,6 +121,7 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
       else if (t == "estimated") c.rsu_covariance = RsuCovariance::kEstimated;
       else r.fail(v, key, "expected published, standard_deviation or estimated");
     } else if (key == "network_trials") c.network_trials = r.integer(v, key, 1, 1000);
+    else if (key == "gate_recovery") c.gate_recovery = r.integer(v, key, 0, 1000);
     else if (key == "bin_length") c.bin_length = r.number(v, key, 0.1, 100.0);
     else if (key == "fuse_config") c.fuse_config = r.text(v, key);
     else if (key == "jobs") c.jobs = r.integer(v, key, 1, 64);
@@ -128,7 +129,7 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     else if (key == "sweep_trials") c.sweep_trials = r.integer(v, key, 1, 1000);
     else if (key == "rsu_heights") c.rsu_heights = r.numbers(v, key, 0.5, 20.0);
     else if (key == "speeds") c.speeds = r.numbers(v, key, 1.0, 40.0);
-    else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, bin_length, fuse_config, jobs, sweeps, "
+    else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, gate_recovery, bin_length, fuse_config, jobs, sweeps, "
                                   "sweep_trials, rsu_heights, speeds)");
   }
   if (c.delays.front() != 0.0 || c.losses.front() != 0.0)

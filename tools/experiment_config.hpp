@@ -33,6 +33,10 @@ struct ExperimentConfig {
   /// Estimated by default: with the fixes carried to their tick (fusion.pose_time_alignment) the
   /// filter can trust them as much as they deserve; Table I shows the paper's figures beside it.
   RsuCovariance rsu_covariance = RsuCovariance::kEstimated;
+  /// fusion.pose_gate_recovery for every replay (a fuse_config brings its own): a filter that
+  /// trusts millimetre fixes must not lock them out when NDT has drifted before the RSU's coverage
+  /// (at 15 m/s NDT is 35 cm off there). 0 = off.
+  int gate_recovery = 3;
   double bin_length = 2.0;      ///< m of road per bin of the paper's metric (minimum error per bin)
   std::string fuse_config;      ///< optional fuse YAML applied to every replay (fusion, ndt, replay keys)
   int jobs = 2;                 ///< replays run side by side (each NDT on one thread)

@@ -29,6 +29,9 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_EQ(c.delays, (std::vector<double>{0.0, 0.010, 0.030}));
   EXPECT_EQ(c.losses, (std::vector<double>{0.0, 0.10, 0.20}));
   EXPECT_DOUBLE_EQ(c.bin_length, 2.0);
+  EXPECT_EQ(c.rsu_covariance, RsuCovariance::kEstimated);
+  EXPECT_EQ(referenceCovariance(c.rsu_covariance), RsuCovariance::kPublished);
+  EXPECT_EQ(c.gate_recovery, 3);
   EXPECT_EQ(quickExperiment(c).trials, 1);
 }
 
