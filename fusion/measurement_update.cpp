@@ -80,12 +80,9 @@ Model model(const FilterState& state, const UpdateRecord& record) {
   return out;
 }
 
-}  // namespace
-
-Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale) {
+Innovation innovationWith(const FilterState& state, const UpdateRecord& record, const Model& mdl, double scale) {
   Innovation out;
   out.m = record.m;
-  const Model mdl = model(state, record);
   const Eigen::Matrix<double, 3, 3> HPHt = mdl.H * state.P * mdl.H.transpose();
   for (int i = 0; i < record.m; ++i) {
     const int si = record.index[i];
@@ -94,6 +91,12 @@ Innovation innovation(const FilterState& state, const UpdateRecord& record, doub
     for (int j = 0; j < record.m; ++j) out.S(i, j) = HPHt(i, j) + scale * record.R(i, j);
   }
   return out;
+}
+
+}  // namespace
+
+Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale) {
+  return innovationWith(state, record, model(state, record), scale);
 }
 
 double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) {
@@ -106,9 +109,10 @@ double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) 
 
 bool applyUpdate(FilterState& state, const UpdateRecord& record) {
   if (record.m > 0) {
-    const Innovation in = innovation(state, record, record.scale);
+    const Model mdl = model(state, record);
+    const Innovation in = innovationWith(state, record, mdl, record.scale);
     // PHt = P H^T (rows of H beyond m are zero).
-    const Eigen::Matrix<double, 6, 3> PHt = state.P * model(state, record).H.transpose();
+    const Eigen::Matrix<double, 6, 3> PHt = state.P * mdl.H.transpose();
     // K = PHt S^-1, computed as (S^-1 PHt^T)^T since S is symmetric.
     Eigen::Matrix<double, 3, 6> KT = Eigen::Matrix<double, 3, 6>::Zero();
     if (!solveSpd<6>(in.S, in.m, PHt.transpose(), KT)) return false;

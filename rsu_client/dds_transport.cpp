@@ -80,10 +80,6 @@ bool waitFor(const std::atomic<int>& matched, int count, std::chrono::millisecon
 // ---- fixes -------------------------------------------------------------------------------------
 
 struct FixSubscriber::Impl : public dds::DataReaderListener {
-  dds::DomainParticipant* participant = nullptr;
-  // Here rather than in the owner's destructor: a constructor that fails after creating the
-  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
-  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
   std::vector<std::pair<dds::DataReader*, std::string>> readers;  ///< reader and its RSU id
   Callback callback;
@@ -115,6 +111,7 @@ struct FixSubscriber::Impl : public dds::DataReaderListener {
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
     matched += status.current_count_change;
   }
+  OwnedParticipant participant;  // last member: deleted first
 };
 
 FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback)
@@ -138,13 +135,10 @@ FixSubscriber::~FixSubscriber() = default;
 int FixSubscriber::matchedPublishers() const { return impl_->matched.load(); }
 
 struct FixPublisher::Impl {
-  dds::DomainParticipant* participant = nullptr;
-  // Here rather than in the owner's destructor: a constructor that fails after creating the
-  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
-  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
   dds::DataWriter* writer = nullptr;
   MatchCounter listener;
+  OwnedParticipant participant;  // last member: deleted first
 };
 
 FixPublisher::FixPublisher(const DdsConfig& config, const std::string& rsu_id) : impl_(std::make_unique<Impl>()) {
@@ -181,13 +175,10 @@ bool FixPublisher::waitForSubscribers(int count, std::chrono::milliseconds timeo
 // ---- vehicle dimensions ------------------------------------------------------------------------
 
 struct DimensionsPublisher::Impl {
-  dds::DomainParticipant* participant = nullptr;
-  // Here rather than in the owner's destructor: a constructor that fails after creating the
-  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
-  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
   dds::DataWriter* writer = nullptr;
   MatchCounter listener;
+  OwnedParticipant participant;  // last member: deleted first
 };
 
 DimensionsPublisher::DimensionsPublisher(const DdsConfig& config) : impl_(std::make_unique<Impl>()) {
@@ -216,10 +207,6 @@ bool DimensionsPublisher::waitForSubscribers(int count, std::chrono::millisecond
 }
 
 struct DimensionsSubscriber::Impl : public dds::DataReaderListener {
-  dds::DomainParticipant* participant = nullptr;
-  // Here rather than in the owner's destructor: a constructor that fails after creating the
-  // participant must not leak it (Fast DDS would delete it at exit, where its teardown can stall).
-  ~Impl() { destroyParticipant(participant); }
   dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
   Callback callback;
   std::atomic<int> matched{0};
@@ -235,6 +222,7 @@ struct DimensionsSubscriber::Impl : public dds::DataReaderListener {
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
     matched += status.current_count_change;
   }
+  OwnedParticipant participant;  // last member: deleted first
 };
 
 DimensionsSubscriber::DimensionsSubscriber(const DdsConfig& config, Callback callback) : impl_(std::make_unique<Impl>()) {

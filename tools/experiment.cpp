@@ -6,12 +6,10 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <thread>
 
 #include "coloc/core/error.hpp"
@@ -148,24 +146,17 @@ void runJobs(std::vector<Job>& jobs, int threads) {
 
 Vector6d fixVariance(double v) { return (Vector6d() << v, v, kInfinity, kInfinity, kInfinity, kInfinity).finished(); }
 
-// The variance per axis of the fixes a recording's RSU made, against ground truth: the "estimated from
-// the data" covariance of the sweep, as a calibration drive past the RSU would give it. Robust (from
-// the median absolute error, as for a normal distribution), because a few gross misfits - the fit on
-// the wrong corner - are the gate's business, not the covariance's.
-double measuredFixVariance(const std::string& fixes_csv, const std::string& rsu_id) {
-  std::ifstream in(fixes_csv);
-  std::string line;
-  std::getline(in, line);
+// The variance per axis of an RSU's fix errors against ground truth: the "estimated from the data"
+// covariance, as a calibration drive past the RSU would give it. Robust (from the median absolute
+// error, as for a normal distribution), because a few gross misfits - the fit on the wrong corner -
+// are the gate's business, not the covariance's.
+double robustFixVariance(const std::vector<Eigen::Vector2d>& errors, const std::string& rsu_id) {
   std::vector<double> abs_errors;
-  while (std::getline(in, line)) {
-    std::stringstream s(line);
-    std::vector<std::string> f;
-    for (std::string cell; std::getline(s, cell, ',');) f.push_back(cell);
-    if (f.size() < 7 || f[1] != rsu_id) continue;
-    abs_errors.push_back(std::abs(std::stod(f[4])));
-    abs_errors.push_back(std::abs(std::stod(f[5])));
+  for (const Eigen::Vector2d& e : errors) {
+    abs_errors.push_back(std::abs(e.x()));
+    abs_errors.push_back(std::abs(e.y()));
   }
-  if (abs_errors.size() < 10) throw Error(fixes_csv + ": too few fixes of " + rsu_id + " to estimate their variance");
+  if (abs_errors.size() < 10) throw Error("RSU " + rsu_id + ": too few fixes on the calibration drive to estimate their variance");
   std::nth_element(abs_errors.begin(), abs_errors.begin() + abs_errors.size() / 2, abs_errors.end());
   const double sigma = 1.4826 * abs_errors[abs_errors.size() / 2];
   return sigma * sigma;
@@ -329,7 +320,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         for (const sim::ScenarioRsu& r : scenario.rsus)
           if (r.lidar_model == lidar) {
             if (!measured.count(r.id)) {
-              measured[r.id] = measuredFixVariance(rec.out_dir + "/rsu_fixes.csv", r.id);
+              const auto errors = summary.fix_errors.find(r.id);
+              measured[r.id] = robustFixVariance(errors == summary.fix_errors.end() ? std::vector<Eigen::Vector2d>{} : errors->second, r.id);
               results.estimated_variance[scenario.name + " " + lidar] = measured[r.id];
             }
             return measured.at(r.id);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -61,10 +62,11 @@ const ExperimentRun* find(const std::vector<ExperimentRun>& runs, const std::str
   return nullptr;
 }
 
-// Minimum error in each bin of road: the paper's per-2-m figure.
-std::map<long, double> binMinima(const ExperimentRun& run, double bin) {
+// Minimum error in each bin of road (the paper's per-2-m figure), over the samples within `range` of the RSU.
+std::map<long, double> binMinima(const ExperimentRun& run, double bin, double range = std::numeric_limits<double>::infinity()) {
   std::map<long, double> m;
   for (std::size_t i = 0; i < run.error.size(); ++i) {
+    if (run.to_rsu[i] > range) continue;
     const long k = static_cast<long>(std::floor(run.along[i] / bin));
     auto it = m.find(k);
     if (it == m.end()) m[k] = run.error[i];
@@ -97,18 +99,11 @@ void writeFile(const std::string& path, const std::string& text) {
 
 ErrorInCoverage errorInCoverage(const ExperimentRun& run, double range, double bin_length) {
   ErrorInCoverage e;
-  std::map<long, double> minima;
-  for (std::size_t i = 0; i < run.error.size(); ++i) {
-    if (run.to_rsu[i] > range) continue;
-    e.plain += run.error[i];
-    ++e.samples;
-    const long k = static_cast<long>(std::floor(run.along[i] / bin_length));
-    auto it = minima.find(k);
-    if (it == minima.end()) minima[k] = run.error[i];
-    else it->second = std::min(it->second, run.error[i]);
-  }
+  for (std::size_t i = 0; i < run.error.size(); ++i)
+    if (run.to_rsu[i] <= range) e.plain += run.error[i], ++e.samples;
   if (e.samples == 0) return e;
   e.plain /= e.samples;
+  const std::map<long, double> minima = binMinima(run, bin_length, range);
   for (const auto& [k, v] : minima) e.paper += v;
   e.paper /= minima.size();
   return e;

@@ -260,6 +260,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const Stamp ready = at(capture + 0.05 + options.rsu_processing);  // end of the sweep + processing
       const std::optional<Stamp> delivered = r.link.transmit(ready);
       const Eigen::Vector2d error = d.position - seen.position;
+      summary.fix_errors[r.info.id].push_back(error);
       fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","
                 << error.y() << "," << error.norm() << "," << d.processing_ms << "," << (delivered ? 1 : 0) << "\n";
       PlotSeries& series = fix_errors[r.info.id];

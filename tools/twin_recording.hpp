@@ -4,8 +4,11 @@
 // emulated V2I link) and ground truth; the survey map as PCD tiles; a fuse configuration. `coloc
 // simulate` records one; `coloc experiment` records one per site and trial and replays it.
 #include <cstdint>
+#include <Eigen/Core>
 #include <functional>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/sim/scene.hpp"
@@ -30,6 +33,8 @@ struct TwinRecordingSummary {
   double map_seconds = 0.0, ray_casting_seconds = 0.0, perception_seconds = 0.0;
   std::uint64_t rays = 0, scans = 0, fixes = 0, fixes_lost = 0;
   std::string map_dir;  ///< where the map the log goes with is
+  /// Per RSU id: each fix's error (x, y) against ground truth, whether the link delivered it or not.
+  std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
 };
 
 /// Throws coloc::Error if the output cannot be written.
