@@ -18,7 +18,12 @@ namespace coloc::io::testing {
 
 namespace fs = std::filesystem;
 
-inline std::string nav2Bag() { return COLOC_SHARED_DATA_DIR "/rosbag2/nav2_turtlebot.mcap"; }
+/// The real recording in data/; a missing file throws, naming it, so that its tests fail with that message.
+inline std::string nav2Bag() {
+  const std::string path = COLOC_DATA_DIR "/rosbag2/nav2_turtlebot.mcap";
+  if (!fs::is_regular_file(path)) throw std::runtime_error("real data file missing: " + path + " (see data/README.md)");
+  return path;
+}
 
 /// A fresh directory under the system temp directory, removed with everything in it.
 class ScratchDir {

@@ -21,21 +21,34 @@ using coloc::testing::realData;
 class RealPair : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    target_ = new PointCloud(loadPcd(realData("hdl32e_pair/target.pcd")));
-    source_ = new PointCloud(voxelDownsample(loadPcd(realData("hdl32e_pair/source.pcd")), 0.1));
-    gt1_ = readMatrix4(realData("hdl32e_pair/T_target_source.gt1.txt"));
+    try {
+      target_ = new PointCloud(loadPcd(realData("hdl32e_pair/target.pcd")));
+      source_ = new PointCloud(voxelDownsample(loadPcd(realData("hdl32e_pair/source.pcd")), 0.1));
+      gt1_ = readMatrix4(realData("hdl32e_pair/T_target_source.gt1.txt"));
+    } catch (const std::exception& e) {
+      load_error_ = new std::string(e.what());
+    }
   }
   static void TearDownTestSuite() {
     delete target_;
     delete source_;
+    delete load_error_;
+    target_ = source_ = nullptr;
+    load_error_ = nullptr;
+  }
+  // Each test fails with the loading error rather than running on clouds that are not there.
+  void SetUp() override {
+    if (load_error_) GTEST_FAIL() << *load_error_;
   }
   static PointCloud* target_;
   static PointCloud* source_;
   static Eigen::Matrix4d gt1_;
+  static std::string* load_error_;
 };
 PointCloud* RealPair::target_ = nullptr;
 PointCloud* RealPair::source_ = nullptr;
 Eigen::Matrix4d RealPair::gt1_;
+std::string* RealPair::load_error_ = nullptr;
 
 TEST_F(RealPair, FastBackendReachesTheReferenceFromIdentity) {
   NdtConfig config;

@@ -1,12 +1,21 @@
 #pragma once
-// Paths and reference values of the real data sets beside the repository.
+// Paths and reference values of the real data sets in the repository's data/ folder.
 #include <Eigen/Core>
+#include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 namespace coloc::testing {
 
-inline std::string realData(const std::string& relative) { return std::string(COLOC_SHARED_DATA_DIR) + "/" + relative; }
+/// The path of a file under data/. A missing file throws, naming it: the test that needs it fails with
+/// that message (GoogleTest reports the exception) instead of crashing on an empty cloud.
+inline std::string realData(const std::string& relative) {
+  const std::string path = std::string(COLOC_DATA_DIR) + "/" + relative;
+  if (!std::filesystem::is_regular_file(path))
+    throw std::runtime_error("real data file missing: " + path + " (the repository's data/ folder; see data/README.md)");
+  return path;
+}
 
 /// A 4x4 row-major matrix from a text file (the hdl32e_pair references).
 inline Eigen::Matrix4d readMatrix4(const std::string& path) {
@@ -14,6 +23,7 @@ inline Eigen::Matrix4d readMatrix4(const std::string& path) {
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) in >> m(r, c);
+  if (!in) throw std::runtime_error(path + ": expected 16 numbers (a 4x4 row-major matrix)");
   return m;
 }
 

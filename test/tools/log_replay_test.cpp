@@ -10,12 +10,13 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "log_replay.hpp"
+#include "real_data.hpp"
 #include "temp_dir.hpp"
 
 namespace coloc::tools {
 namespace {
 
-const std::string kNav2 = COLOC_SHARED_DATA_DIR "/rosbag2/nav2_turtlebot.mcap";
+std::string nav2() { return testing::realData("rosbag2/nav2_turtlebot.mcap"); }
 
 io::TopicInfo topicOf(const std::string& name, const std::string& type) {
   io::TopicInfo info;
@@ -37,7 +38,7 @@ const fusion::SourceCounters& counters(const ReplayResult& r, const std::string&
 }
 
 TEST(LogReplay, RealNav2RecordingIsFusedFromAmclPosesAndOdometryTwist) {
-  const ReplayResult r = replayLog(kNav2, {});
+  const ReplayResult r = replayLog(nav2(), {});
   EXPECT_EQ(topic(r, "/amcl_pose").role, InputRole::kPose);
   EXPECT_EQ(topic(r, "/odom").role, InputRole::kTwist);
   EXPECT_EQ(topic(r, "/tf").role, InputRole::kIgnore);
@@ -70,8 +71,8 @@ TEST(LogReplay, RealNav2RecordingIsFusedFromAmclPosesAndOdometryTwist) {
 
 TEST(LogReplay, Sqlite3ConversionOfTheRecordingGivesTheSameFusedOutput) {
   testing::TempDir dir;
-  io::convert(kNav2, dir / "nav2");
-  const ReplayResult from_mcap = replayLog(kNav2, {});
+  io::convert(nav2(), dir / "nav2");
+  const ReplayResult from_mcap = replayLog(nav2(), {});
   const ReplayResult from_db3 = replayLog(dir / "nav2", {});
   ASSERT_EQ(from_mcap.fused.size(), from_db3.fused.size());
   for (std::size_t i = 0; i < from_mcap.fused.size(); ++i) {
@@ -208,8 +209,8 @@ io::PointCloud2 toMessage(const ndt::PointCloud& cloud, Stamp stamp) {
 TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   // The real HDL-32E pair: the target scan is the map, the source scan is in the log.
   testing::TempDir dir;
-  const std::string map = COLOC_SHARED_DATA_DIR "/hdl32e_pair/target.pcd";
-  const ndt::PointCloud scan = ndt::loadPcd(COLOC_SHARED_DATA_DIR "/hdl32e_pair/source.pcd");
+  const std::string map = testing::realData("hdl32e_pair/target.pcd");
+  const ndt::PointCloud scan = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
   const Stamp t0 = 1'700'000'000'000'000'000LL;
   {
     io::BagWriter bag = io::BagWriter::create(dir / "scans");
@@ -228,12 +229,7 @@ TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   EXPECT_EQ(topic(r, "/points").role, InputRole::kScan);
   EXPECT_EQ(r.ndt.scans, 3u);
   EXPECT_EQ(r.ndt.poses, 3u);
-  const Eigen::Matrix4d gt1 = [] {
-    std::ifstream in(COLOC_SHARED_DATA_DIR "/hdl32e_pair/T_target_source.gt1.txt");
-    Eigen::Matrix4d m;
-    for (int i = 0; i < 16; ++i) in >> m(i / 4, i % 4);
-    return m;
-  }();
+  const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
   ASSERT_FALSE(r.pose_inputs.empty());
   EXPECT_NEAR(r.pose_inputs.back().pose.position.x(), gt1(0, 3), 0.03);
   EXPECT_NEAR(r.pose_inputs.back().pose.position.y(), gt1(1, 3), 0.03);
