@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstring>
+#include <limits>
 
 #include "Imu.h"
 #include "Odometry.h"
@@ -436,6 +437,35 @@ Bytes encodePointCloud2(const PointCloud2& message) {
   msg.data(message.data);
   msg.is_dense(message.is_dense);
   return detail::serializeCdr(msg, kPointCloud2Type);
+}
+
+// ---- rosgraph_msgs/Clock: two 32-bit fields, written by hand ----
+
+Bytes encodeClock(Stamp time) {
+  const Stamp sec = time >= 0 ? time / kNanosPerSecond : (time - kNanosPerSecond + 1) / kNanosPerSecond;
+  if (sec > std::numeric_limits<std::int32_t>::max() || sec < std::numeric_limits<std::int32_t>::min())
+    throw Error("Clock: " + formatSeconds(time) + " s does not fit builtin_interfaces/Time (int32 seconds)");
+  const auto s32 = static_cast<std::int32_t>(sec);
+  const auto ns = static_cast<std::uint32_t>(time - sec * kNanosPerSecond);
+  Bytes b = {0x00, 0x01, 0x00, 0x00};  // XCDR1, little endian
+  for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(s32) >> (8 * i)));
+  for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(ns >> (8 * i)));
+  return b;
+}
+
+Stamp decodeClock(const std::uint8_t* data, std::size_t size) {
+  if (size < 12) throw Error("Clock: " + std::to_string(size) + " bytes, expected 12");
+  if (data[0] != 0 || data[1] > 1) throw Error("Clock: encapsulation is not plain CDR");
+  const bool little = data[1] == 1;
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(data[at + (little ? i : 3 - i)]) << (8 * i);
+    return v;
+  };
+  const auto sec = static_cast<std::int32_t>(u32(4));
+  const std::uint32_t ns = u32(8);
+  if (ns >= kNanosPerSecond) throw Error("Clock: nanosec " + std::to_string(ns) + " is not below 1e9");
+  return static_cast<Stamp>(sec) * kNanosPerSecond + ns;
 }
 
 }  // namespace coloc::io

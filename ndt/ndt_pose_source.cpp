@@ -16,7 +16,7 @@ Eigen::Matrix4d matrixOf(const Pose& pose) {
 }  // namespace
 
 NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config)
-    : config_(config), map_(std::move(map), config.ndt, config.map) {
+    : config_((validate(config), config)), map_(std::move(map), config.ndt, config.map) {
   const Vector6d& p = config.lidar_pose;
   Pose lidar;
   lidar.position = p.head<3>();

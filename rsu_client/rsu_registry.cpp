@@ -3,11 +3,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <sstream>
 
-#include "coloc/core/config_error.hpp"
+#include "coloc/core/error.hpp"
+#include "coloc/core/yaml_reader.hpp"
 
 namespace coloc::rsu_client {
 
@@ -25,31 +27,9 @@ const LidarModel* findLidarModel(const std::string& name) {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& source, const YAML::Node& node, const std::string& key, const std::string& why) {
-  throwConfigError(source, node.Mark().line, key, why);
-}
-
-double number(const std::string& source, const YAML::Node& node, const std::string& key) {
-  try {
-    const double v = node.as<double>();
-    if (!std::isfinite(v)) fail(source, node, key, "must be finite");
-    return v;
-  } catch (const YAML::Exception&) {
-    fail(source, node, key, "expected a number");
-  }
-}
-
-std::string text(const std::string& source, const YAML::Node& node, const std::string& key) {
-  try {
-    return node.as<std::string>();
-  } catch (const YAML::Exception&) {
-    fail(source, node, key, "expected a string");
-  }
-}
-
-RsuInfo readRsu(const std::string& source, const YAML::Node& node, std::size_t index) {
+RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) {
   const std::string where = "rsus[" + std::to_string(index) + "]";
-  if (!node.IsMap()) fail(source, node, where, "expected a mapping");
+  r.allowKeys(node, where, {"id", "position", "height", "lidar_model", "coverage_radius", "identity", "calibrated_variance"});
   RsuInfo rsu;
   bool has_position = false, has_model = false;
   std::optional<double> radius;
@@ -57,38 +37,35 @@ RsuInfo readRsu(const std::string& source, const YAML::Node& node, std::size_t i
     const std::string key = entry.first.as<std::string>();
     const std::string full = where + "." + key;
     if (key == "id") {
-      rsu.id = text(source, entry.second, full);
+      rsu.id = r.text(entry.second, full);
     } else if (key == "position") {
-      if (!entry.second.IsSequence() || entry.second.size() != 2) fail(source, entry.second, full, "expected [x, y] in the map frame");
-      rsu.position = {number(source, entry.second[0], full), number(source, entry.second[1], full)};
+      const auto v = r.numbers(entry.second, full, 2, "[x, y] in the map frame");
+      rsu.position = {v[0], v[1]};
+      if (!rsu.position.allFinite()) r.fail(entry.second, full, "must be finite");
       has_position = true;
     } else if (key == "height") {
-      rsu.height = number(source, entry.second, full);
-      if (rsu.height <= 0.0 || rsu.height > 30.0) fail(source, entry.second, full, "must be in (0, 30] m");
+      rsu.height = r.inRange(entry.second, full, 0.0, 30.0);
+      if (rsu.height == 0.0) r.fail(entry.second, full, "must be above the road (> 0 m)");
     } else if (key == "lidar_model") {
-      const std::string name = text(source, entry.second, full);
+      const std::string name = r.text(entry.second, full);
       const LidarModel* model = findLidarModel(name);
-      if (!model) fail(source, entry.second, full, "unknown LiDAR model '" + name + "' (known: VLP-16, VLP-32C)");
+      if (!model) r.fail(entry.second, full, "unknown LiDAR model '" + name + "' (known: VLP-16, VLP-32C)");
       rsu.lidar = *model;
       has_model = true;
     } else if (key == "coverage_radius") {
-      radius = number(source, entry.second, full);
-      if (*radius <= 0.0) fail(source, entry.second, full, "must be > 0 m");
+      radius = r.positive(entry.second, full);
     } else if (key == "identity") {
-      rsu.identity = text(source, entry.second, full);
+      rsu.identity = r.text(entry.second, full);
     } else if (key == "calibrated_variance") {
-      rsu.calibrated_variance = number(source, entry.second, full);
-      if (*rsu.calibrated_variance <= 0.0) fail(source, entry.second, full, "must be > 0 m^2");
-    } else {
-      fail(source, entry.first, full, "unknown key (id, position, height, lidar_model, coverage_radius, identity, calibrated_variance)");
+      rsu.calibrated_variance = r.positive(entry.second, full);
     }
   }
-  if (rsu.id.empty()) fail(source, node, where, "needs an id");
-  if (!has_position) fail(source, node, where + " (" + rsu.id + ")", "needs a position");
-  if (!has_model) fail(source, node, where + " (" + rsu.id + ")", "needs a lidar_model");
+  if (rsu.id.empty()) r.fail(node, where, "needs an id");
+  if (!has_position) r.fail(node, where + " (" + rsu.id + ")", "needs a position");
+  if (!has_model) r.fail(node, where + " (" + rsu.id + ")", "needs a lidar_model");
   for (char c : rsu.id)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
-      fail(source, node, where + ".id", "'" + rsu.id + "': use letters, digits and _ (it becomes part of a DDS topic name)");
+      r.fail(node, where + ".id", "'" + rsu.id + "': use letters, digits and _ (it becomes part of a DDS topic name)");
   rsu.coverage_radius = radius.value_or(rsu.lidar.range);
   if (rsu.identity.empty()) rsu.identity = "CN=" + rsu.id;
   return rsu;
@@ -97,31 +74,26 @@ RsuInfo readRsu(const std::string& source, const YAML::Node& node, std::size_t i
 }  // namespace
 
 RsuRegistry RsuRegistry::parse(const std::string& yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw Error(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
-  }
+  const YamlReader r(source);
+  const YAML::Node root = r.parse(yaml_text);
   RsuRegistry registry;
-  if (!root.IsMap()) fail(source, root, "(top level)", "expected a mapping with covariance_placement and rsus");
+  if (!root.IsMap()) r.fail(root, "(top level)", "expected a mapping with covariance_placement and rsus");
   std::set<std::string> ids;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
     if (key == "covariance_placement") {
-      const std::string v = text(source, entry.second, key);
-      if (v == "published") registry.placement_ = CovariancePlacement::kPublished;
-      else if (v == "standard_deviation") registry.placement_ = CovariancePlacement::kStandardDeviation;
-      else fail(source, entry.second, key, "expected published or standard_deviation, got '" + v + "'");
+      registry.placement_ = r.choice(entry.second, key, {"published", "standard_deviation"}) == "published"
+                                ? CovariancePlacement::kPublished
+                                : CovariancePlacement::kStandardDeviation;
     } else if (key == "rsus") {
-      if (!entry.second.IsSequence()) fail(source, entry.second, key, "expected a list of roadside units");
+      if (!entry.second.IsSequence()) r.fail(entry.second, key, "expected a list of roadside units");
       for (std::size_t i = 0; i < entry.second.size(); ++i) {
-        RsuInfo rsu = readRsu(source, entry.second[i], i);
-        if (!ids.insert(rsu.id).second) fail(source, entry.second[i], "rsus[" + std::to_string(i) + "].id", "'" + rsu.id + "' appears twice");
+        RsuInfo rsu = readRsu(r, entry.second[i], i);
+        if (!ids.insert(rsu.id).second) r.fail(entry.second[i], "rsus[" + std::to_string(i) + "].id", "'" + rsu.id + "' appears twice");
         registry.rsus_.push_back(std::move(rsu));
       }
     } else {
-      fail(source, entry.first, key, "unknown key (covariance_placement, rsus)");
+      r.fail(entry.first, key, "unknown key (covariance_placement, rsus)");
     }
   }
   return registry;
@@ -133,6 +105,36 @@ RsuRegistry RsuRegistry::load(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return parse(s.str(), path);
+}
+
+RsuRegistry::RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement) {
+  RsuRegistry probe;
+  probe.rsus_ = rsus;
+  probe.placement_ = placement;
+  // Through the file format, so that an entry made in code passes exactly the checks a file does.
+  *this = parse(probe.toYaml(), "(RSU registry made in code)");
+}
+
+std::string RsuRegistry::toYaml() const {
+  auto number = [](double v) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.17g", v);
+    return std::string(b);
+  };
+  std::ostringstream out;
+  out << "# Roadside units the vehicle accepts fixes from (coloc RSU registry). Positions are in the map frame.\n"
+      << "covariance_placement: " << (placement_ == CovariancePlacement::kPublished ? "published" : "standard_deviation") << "\n"
+      << "rsus:" << (rsus_.empty() ? " []" : "") << "\n";
+  for (const RsuInfo& r : rsus_) {
+    out << "  - id: " << r.id << "\n"
+        << "    position: [" << number(r.position.x()) << ", " << number(r.position.y()) << "]\n"
+        << "    height: " << number(r.height) << "\n"
+        << "    lidar_model: " << r.lidar.name << "\n"
+        << "    coverage_radius: " << number(r.coverage_radius) << "\n"
+        << "    identity: \"" << r.identity << "\"\n";
+    if (r.calibrated_variance) out << "    calibrated_variance: " << number(*r.calibrated_variance) << "\n";
+  }
+  return out.str();
 }
 
 const RsuInfo* RsuRegistry::find(const std::string& id) const {

@@ -12,5 +12,7 @@ void addRsuListenCommand(CLI::App& app);
 void addRsuPublishCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addExperimentCommand(CLI::App& app);
+void addLocalizeCommand(CLI::App& app);
+void addPlayCommand(CLI::App& app);
 
 }  // namespace coloc::tools

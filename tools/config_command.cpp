@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
-#include "fuse_config.hpp"
+#include "coloc/pipeline/config.hpp"
 
 namespace coloc::tools {
 
@@ -15,11 +15,11 @@ void addConfigCommand(CLI::App& app) {
   cmd->add_option("--check", check, "validate this YAML file and exit")->check(CLI::ExistingFile);
   cmd->callback([] {
     if (!check.empty()) {
-      loadFuseConfig(check);
+      pipeline::loadConfig(check);
       std::printf("%s: valid\n", check.c_str());
       return;
     }
-    std::fputs((markdown ? configReferenceMarkdown() : defaultConfigYaml()).c_str(), stdout);
+    std::fputs((markdown ? pipeline::configReferenceMarkdown() : pipeline::defaultConfigYaml()).c_str(), stdout);
   });
 }
 

@@ -16,8 +16,9 @@
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/scene.hpp"
 #include "coloc/sim/vehicle_motion.hpp"
-#include "fuse_config.hpp"
-#include "log_replay.hpp"
+#include "coloc/pipeline/config.hpp"
+#include "coloc/replay/log_replay.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
 #include "twin_recording.hpp"
 
 namespace coloc::tools {
@@ -86,22 +87,24 @@ SiteInfo siteInfo(const sim::Scenario& s) {
 struct Job {
   ExperimentRun run;
   std::string log, map;
-  FuseConfig config;
+  pipeline::Config config;
+  std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSU, its fixes through the registry's checks
   std::string fix_topic;  ///< the fused RSU topic, empty for NDT only
   std::vector<Eigen::Vector2d> rsu_positions;
 };
 
 // Replays one configuration and measures its error along the drive.
 void runJob(Job& job) {
-  ReplayOptions options;
+  replay::ReplayOptions options;
   options.config = job.config;
+  options.registry = job.registry;
   options.map = job.map;
-  const ReplayResult r = replayLog(job.log, options);
+  const replay::ReplayResult r = replay::replayLog(job.log, options);
   // Distance along the drive at each ground-truth sample.
   std::vector<double> along(r.ground_truth.size(), 0.0);
   for (std::size_t i = 1; i < r.ground_truth.size(); ++i)
     along[i] = along[i - 1] + (r.ground_truth[i].pose.position.head<2>() - r.ground_truth[i - 1].pose.position.head<2>()).norm();
-  for (const ErrorSample& e : r.errors) {
+  for (const replay::ErrorSample& e : r.errors) {
     const auto it = std::lower_bound(r.ground_truth.begin(), r.ground_truth.end(), e.stamp,
                                      [](const io::TrajectoryPoint& p, Stamp s) { return p.stamp < s; });
     const std::size_t i = std::min<std::size_t>(it - r.ground_truth.begin(), along.size() - 1);
@@ -116,7 +119,7 @@ void runJob(Job& job) {
       job.run.fixes_applied = s.counters.applied;
       job.run.fixes_gated = s.counters.gated;
     }
-  for (const TopicUse& t : r.topics)
+  for (const replay::TopicUse& t : r.topics)
     if (t.topic == job.fix_topic) job.run.fixes_lost = t.link_dropped;
   job.run.replay_seconds = r.wall_seconds;
 }
@@ -143,8 +146,6 @@ void runJobs(std::vector<Job>& jobs, int threads) {
   for (std::thread& t : pool) t.join();
   if (failure) std::rethrow_exception(failure);
 }
-
-Vector6d fixVariance(double v) { return (Vector6d() << v, v, kInfinity, kInfinity, kInfinity, kInfinity).finished(); }
 
 // The variance per axis of an RSU's fix errors against ground truth: the "estimated from the data"
 // covariance, as a calibration drive past the RSU would give it. Robust (from the median absolute
@@ -181,9 +182,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   ExperimentResults results;
   results.config = config;
   results.work_dir = out_dir + "/recordings";
-  FuseConfig base;
+  pipeline::Config base;
   base.fusion.pose_gate_recovery = config.gate_recovery;
-  if (!config.fuse_config.empty()) base = loadFuseConfig(config.fuse_config);  // a full configuration: its own gate recovery
+  if (!config.fuse_config.empty()) base = pipeline::loadConfig(config.fuse_config);  // a full configuration: its own gate recovery
   base.ndt.source.ndt.threads = 1;  // the replays run side by side instead: small scans scale poorly over threads
 
   // The work, counted in drives; each drive is followed by its replays.
@@ -272,8 +273,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     const double simulated_in = recorded.seconds;
 
     // Its replays.
-    FuseConfig fuse = base;
-    fuse.replay.initial_pose = Eigen::Vector4d(scenario.route_start.x(), scenario.route_start.y(), 0.0, scenario.route_heading);
+    pipeline::Config fuse = base;
+    fuse.pipeline.initial_pose = Eigen::Vector4d(scenario.route_start.x(), scenario.route_start.y(), 0.0, scenario.route_heading);
     fuse.ndt.source.lidar_pose = Vector6d::Zero();
     fuse.ndt.source.lidar_pose[2] = scenario.vehicle_lidar_height;
     std::vector<Eigen::Vector2d> rsu_positions;
@@ -292,13 +293,15 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.config = fuse;
       job.rsu_positions = rsu_positions;
       for (const sim::ScenarioRsu& r : scenario.rsus) {
-        InputConfig input;
-        const std::string topic = rsuFixTopic(r.id);
+        pipeline::InputConfig input;
+        const std::string topic = rsu_client::fixTopic(r.id);
         if (r.lidar_model == lidar) {
-          input.role = InputRole::kPose;
-          input.source = topic;
+          // The fixes pass the same checks as fixes over DDS; the registry carries the variance chosen.
+          input.role = pipeline::InputRole::kRsuFix;
           job.fix_topic = topic;
-          if (variance) input.covariance_diagonal = fixVariance(*variance);
+          rsu_client::RsuInfo info = registryEntry(r);
+          info.calibrated_variance = variance;
+          job.registry = rsu_client::RsuRegistry({info}, rsu_client::CovariancePlacement::kPublished);
           if (delay > 0.0 || loss > 0.0) {
             rsu_client::LinkConfig link;
             link.delay = delay;

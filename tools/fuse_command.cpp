@@ -8,7 +8,7 @@
 
 #include "coloc/core/error.hpp"
 #include "commands.hpp"
-#include "log_replay.hpp"
+#include "coloc/replay/log_replay.hpp"
 #include "progress.hpp"
 #include "svg_plot.hpp"
 
@@ -17,89 +17,7 @@ namespace coloc::tools {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct ErrorStats {
-  double mean = 0.0, rmse = 0.0, max = 0.0;
-};
-
-ErrorStats errorStats(const std::vector<ErrorSample>& errors) {
-  ErrorStats s;
-  for (const ErrorSample& e : errors) {
-    s.mean += e.error;
-    s.rmse += e.error * e.error;
-    s.max = std::max(s.max, e.error);
-  }
-  if (!errors.empty()) {
-    s.mean /= errors.size();
-    s.rmse = std::sqrt(s.rmse / errors.size());
-  }
-  return s;
-}
-
-nlohmann::ordered_json countersJson(const fusion::SourceCounters& c) {
-  return {{"received", c.received},   {"applied", c.applied},         {"gated", c.gated},
-          {"too_old", c.too_old},     {"from_future", c.from_future}, {"invalid", c.invalid},
-          {"not_initialized", c.not_initialized}, {"numerical", c.numerical}, {"pending", c.pending},
-          {"smoothing_shortened", c.smoothing_shortened},
-          {"gate_recovered", c.gate_recovered}};
-}
-
-// Everything in summary.json is a function of the log and the config, so that reruns give the same
-// bytes; run times go to timing.json.
-nlohmann::ordered_json summaryJson(const std::string& log, const ReplayResult& r) {
-  nlohmann::ordered_json j;
-  j["log"] = log;
-  j["messages"] = r.messages_read;
-  j["log_duration_s"] = r.log_duration;
-  j["clock"] = {{"mode", r.clock == ClockMode::kSeparate ? "separate" : "same"}};
-  if (r.clock == ClockMode::kSeparate) {
-    j["clock"]["rate"] = r.clock_fit.rate;
-    j["clock"]["log_origin"] = formatSeconds(r.clock_fit.log_origin);
-    j["clock"]["stamp_origin"] = formatSeconds(r.clock_fit.stamp_origin);
-  }
-  auto& topics = j["topics"] = nlohmann::ordered_json::array();
-  for (const TopicUse& t : r.topics) {
-    nlohmann::ordered_json o = {{"topic", t.topic}, {"type", t.type}, {"role", toString(t.role)}, {"messages", t.messages}};
-    if (t.role == InputRole::kPose || t.role == InputRole::kTwist) o["source"] = t.source;
-    if (t.role != InputRole::kIgnore) {
-      o["decode_errors"] = t.decode_errors;
-      o["fallback_covariance"] = t.fallback_covariance;
-      o["link_dropped"] = t.link_dropped;
-      o["delay_median_s"] = t.delay_median;
-      o["delay_max_s"] = t.delay_max;
-    }
-    if (!t.first_error.empty()) o["first_error"] = t.first_error;
-    if (!t.note.empty()) o["note"] = t.note;
-    topics.push_back(o);
-  }
-  auto& sources = j["sources"] = nlohmann::ordered_json::array();
-  for (const auto& s : r.sources)
-    sources.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"},
-                       {"counters", countersJson(s.counters)}});
-  j["fused"] = {{"file", "fused.tum"}, {"poses", r.fused.size()},
-                {"first_stamp", formatSeconds(r.first_stamp)}, {"last_stamp", formatSeconds(r.last_stamp)}};
-  if (!r.errors.empty()) {
-    const ErrorStats s = errorStats(r.errors);
-    j["position_error"] = {{"samples", r.errors.size()}, {"mean_m", s.mean}, {"rmse_m", s.rmse}, {"max_m", s.max},
-                           {"file", "error.csv"}};
-  } else {
-    j["position_error"] = nullptr;
-  }
-  if (r.ndt_used) {
-    j["ndt"] = {{"scans", r.ndt.scans},
-                {"poses", r.ndt.poses},
-                {"scans_without_guess", r.scans_without_guess},
-                {"no_map", r.ndt.no_map},
-                {"empty_scan", r.ndt.empty_scan},
-                {"max_iterations", r.ndt.max_iterations},
-                {"oscillation", r.ndt.oscillation},
-                {"low_score", r.ndt.low_score},
-                {"map_builds", r.map.builds},
-                {"tiles_in_target", r.map.tiles_in_target}};
-  }
-  j["rejections_first"] = r.rejections;
-  return j;
-}
+using namespace coloc::replay;
 
 void printSummary(const std::string& log, const ReplayResult& r, const std::string& out_dir) {
   std::printf("coloc fuse %s\n", log.c_str());
@@ -140,7 +58,7 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 r.map.builds);
   }
   if (!r.errors.empty()) {
-    const ErrorStats s = errorStats(r.errors);
+    const ErrorStats s = r.errorStats();
     std::printf("\n  position error vs ground truth (%zu ticks): mean %.4f m, RMSE %.4f m, max %.4f m\n", r.errors.size(), s.mean,
                 s.rmse, s.max);
   } else {
@@ -178,18 +96,6 @@ void writePlots(const ReplayResult& r, const std::string& dir, const std::string
   writeSvg(dir + "/error.svg", error);
 }
 
-void writeErrorCsv(const ReplayResult& r, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw Error(path + ": cannot write");
-  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m\n";
-  char line[256];
-  for (const ErrorSample& s : r.errors) {
-    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(), s.estimate.y(),
-                  s.truth.x(), s.truth.y(), s.error);
-    out << line;
-  }
-}
-
 }  // namespace
 
 void addFuseCommand(CLI::App& app) {
@@ -201,7 +107,7 @@ void addFuseCommand(CLI::App& app) {
   cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
   cmd->callback([] {
     ReplayOptions options;
-    if (!config_path.empty()) options.config = loadFuseConfig(config_path);
+    if (!config_path.empty()) options.config = pipeline::loadConfig(config_path);
     options.map = map;
     ProgressBar progress("fusing");
     options.progress = [&](double f) { progress.update(f); };
@@ -213,11 +119,11 @@ void addFuseCommand(CLI::App& app) {
     // The header names no file, so the same data in another storage format gives the same bytes.
     io::writeTumTrajectory(out_dir + "/fused.tum", result.fused,
                            "coloc fused trajectory\nt x y z qx qy qz qw (t: header-stamp clock, s)");
-    std::ofstream(out_dir + "/summary.json") << summaryJson(log, result).dump(2) << "\n";
+    std::ofstream(out_dir + "/summary.json") << result.summaryJson(log);
     nlohmann::ordered_json timing = {{"replay_wall_s", result.wall_seconds},
                                      {"speed_x_realtime", result.wall_seconds > 0 ? result.log_duration / result.wall_seconds : 0.0}};
     std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
-    if (!result.errors.empty()) writeErrorCsv(result, out_dir + "/error.csv");
+    if (!result.errors.empty()) result.writeErrorCsv(out_dir + "/error.csv");
     writePlots(result, out_dir, log);
     printSummary(log, result, out_dir);
   });

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   coloc::tools::addRsuPublishCommand(app);
   coloc::tools::addSimulateCommand(app);
   coloc::tools::addExperimentCommand(app);
+  coloc::tools::addLocalizeCommand(app);
+  coloc::tools::addPlayCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

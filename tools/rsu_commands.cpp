@@ -12,50 +12,12 @@
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "commands.hpp"
+#include "dds_options.hpp"
 #include "teardown_watchdog.hpp"
 
 namespace coloc::tools {
 
 namespace {
-
-struct DdsOptions {
-  int domain = 0;
-  bool reliable = false;
-  bool any_interface = false;
-  std::string security_dir;  ///< folder with ca.pem, <name>.pem, <name>_key.pem, governance.p7s, <name>_permissions.p7s
-  std::string name;
-};
-
-void addDdsOptions(CLI::App* cmd, DdsOptions& o) {
-  cmd->add_option("--domain", o.domain, "DDS domain (ROS_DOMAIN_ID)")->capture_default_str();
-  cmd->add_flag("--reliable", o.reliable, "reliable QoS instead of ROS 2 sensor data (best effort, keep last 5)");
-  cmd->add_flag("--any-interface", o.any_interface, "Fast DDS default transports instead of UDP on loopback");
-  cmd->add_option("--security", o.security_dir,
-                  "folder with DDS Security files: identity_ca.pem, permissions_ca.pem, governance.p7s, NAME.pem, "
-                  "NAME_key.pem, NAME_permissions.p7s (NAME: --name)");
-}
-
-rsu_client::DdsConfig ddsConfig(const DdsOptions& o, const std::string& default_name) {
-  rsu_client::DdsConfig c;
-  c.domain = o.domain;
-  c.reliable = o.reliable;
-  c.loopback_only = !o.any_interface;
-  c.participant_name = o.name.empty() ? default_name : o.name;
-  if (!o.security_dir.empty()) {
-    const std::string d = o.security_dir + "/", n = c.participant_name;
-    c.security = {true, d + "identity_ca.pem", d + n + ".pem", d + n + "_key.pem", d + "permissions_ca.pem", d + "governance.p7s",
-                  d + n + "_permissions.p7s"};
-  }
-  return c;
-}
-
-void printSecurity(const rsu_client::DdsConfig& c) {
-  if (c.security.enabled)
-    std::printf("DDS Security on: PKI-DH authentication, access control, AES-GCM (identity %s)\n", c.security.identity_certificate.c_str());
-  else
-    std::printf("DDS Security OFF: fixes are accepted from any participant that publishes on the topics\n");
-  std::fflush(stdout);
-}
 
 std::vector<rsu_client::RsuFix> fixesFromFile(const std::string& path, const std::string& rsu) {
   std::ifstream in(path);

@@ -15,6 +15,7 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/tile_map.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/sim/roadside_perception.hpp"
@@ -35,7 +36,11 @@ Stamp at(double t) { return kEpoch + fromSeconds(t); }
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-sim::LidarSpec lidarNamed(const std::string& name) { return name == "VLP-16" ? sim::vlp16() : sim::vlp32c(); }
+sim::LidarSpec lidarNamed(const std::string& name) {
+  if (name == "VLP-16") return sim::vlp16();
+  if (name == "VLP-32C") return sim::vlp32c();
+  throw Error("no LiDAR model '" + name + "' in the twin (VLP-16, VLP-32C)");
+}
 
 std::uint64_t raysPerSweep(const sim::LidarSpec& spec) {
   return spec.vertical_deg.size() * static_cast<std::uint64_t>(std::lround(360.0 / spec.azimuth_step_deg));
@@ -111,7 +116,18 @@ void writeMap(const sim::Scenario& scenario, const std::string& dir) {
 
 }  // namespace
 
-std::string rsuFixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/fix"; }
+rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& r) {
+  const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
+  if (!model) throw Error("RSU " + r.id + ": no LiDAR model '" + r.lidar_model + "' (VLP-16, VLP-32C)");
+  rsu_client::RsuInfo info;
+  info.id = r.id;
+  info.position = r.position;
+  info.height = r.height;
+  info.lidar = *model;
+  info.coverage_radius = model->range;
+  info.identity = "CN=" + r.id;
+  return info;
+}
 
 TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordingOptions& options) {
   const auto wall_start = Clock::now();
@@ -176,7 +192,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   bag.addTopic(topic("/points", "sensor_msgs/msg/PointCloud2"));
   bag.addTopic(topic("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
   bag.addTopic(topic("/ground_truth/odom", "nav_msgs/msg/Odometry"));
-  for (const Rsu& r : rsus) bag.addTopic(topic(rsuFixTopic(r.info.id), "geometry_msgs/msg/PoseWithCovarianceStamped"));
+  for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::fixTopic(r.info.id), "geometry_msgs/msg/PoseWithCovarianceStamped"));
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream ablation_csv;
@@ -278,7 +294,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       fix.measurement.covariance = Matrix6d::Zero();
       fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;
       const io::Bytes fb = io::encodePoseWithCovarianceStamped(fix);
-      bag.write(rsuFixTopic(r.info.id), *delivered, fb.data(), fb.size());
+      bag.write(rsu_client::fixTopic(r.info.id), *delivered, fb.data(), fb.size());
       ++summary.fixes;
     }
   }
@@ -303,11 +319,16 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       plot.series.push_back(binnedMean(key.first + ": " + kVariants[key.second].name, xy.first, xy.second, 5.0));
     writeSvg(out_dir + "/rsu_perception.svg", plot);
   }
-  // 5. How to replay it: NDT needs a first guess; the twin knows where the drive starts.
+  // 5. How to replay it: NDT needs a first guess, which the twin knows, and the fixes pass the checks of
+  // a registry of the scenario's RSUs, as fixes received over DDS do.
+  std::vector<rsu_client::RsuInfo> registry;
+  for (const sim::ScenarioRsu& r : scenario.rsus) registry.push_back(registryEntry(r));
+  std::ofstream(out_dir + "/rsu.yaml") << rsu_client::RsuRegistry(registry, rsu_client::CovariancePlacement::kPublished).toYaml();
   std::ofstream fuse(out_dir + "/fuse.yaml");
   fuse << "# coloc fuse " << out_dir << "/log --map " << summary.map_dir << " --config " << out_dir << "/fuse.yaml\n"
-       << "replay:\n  initial_pose: [" << scenario.route_start.x() << ", " << scenario.route_start.y() << ", 0.0, " << scenario.route_heading
-       << "]\nndt:\n  lidar_pose: [0.0, 0.0, " << scenario.vehicle_lidar_height << ", 0.0, 0.0, 0.0]\n";
+       << "pipeline:\n  initial_pose: [" << scenario.route_start.x() << ", " << scenario.route_start.y() << ", 0.0, " << scenario.route_heading
+       << "]\nndt:\n  lidar_pose: [0.0, 0.0, " << scenario.vehicle_lidar_height << ", 0.0, 0.0, 0.0]\n"
+       << "rsu:\n  registry: rsu.yaml\n";
   summary.drive_seconds = drive.duration();
   summary.wall_seconds = since(wall_start);
   return summary;

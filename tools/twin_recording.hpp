@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "coloc/rsu_client/link_emulator.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/scene.hpp"
 
 namespace coloc::tools {
@@ -40,7 +41,7 @@ struct TwinRecordingSummary {
 /// Throws coloc::Error if the output cannot be written.
 TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordingOptions& options);
 
-/// The topic a scenario RSU's fixes are recorded on.
-std::string rsuFixTopic(const std::string& rsu_id);
+/// A scenario RSU as the vehicle's registry lists it (surveyed position, model, coverage, identity).
+rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& rsu);
 
 }  // namespace coloc::tools

@@ -51,12 +51,12 @@ TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, colour: red}\n", "rsus[0].colour: unknown key");
   expectError("rsus:\n  - {id: a, lidar_model: VLP-16}\n", "needs a position");
   expectError("rsus:\n  - {id: a, position: [0], lidar_model: VLP-16}\n", "expected [x, y]");
-  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, coverage_radius: -3}\n", "must be > 0");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, coverage_radius: -3}\n", "rsus[0].coverage_radius: must be a finite number > 0");
   expectError("rsus:\n  - {id: a/b, position: [0, 0], lidar_model: VLP-16}\n", "DDS topic");
-  expectError("covariance_placement: guessed\n", "expected published or standard_deviation");
+  expectError("covariance_placement: guessed\n", "covariance_placement: expected one of published, standard_deviation");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0}\n",
-              "rsus[0].calibrated_variance: must be > 0");
-  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: .nan}\n", "must be finite");
+              "rsus[0].calibrated_variance: must be a finite number > 0");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: .nan}\n", "rsus[0].calibrated_variance: must not be NaN");
   expectError("rsu:\n  - {}\n", "rsu: unknown key");
 }
 

@@ -145,4 +145,12 @@ Bytes encodeOdometry(const Odometry& message);
 Bytes encodeImu(const Imu& message);
 Bytes encodePointCloud2(const PointCloud2& message);
 
+/// rosgraph_msgs/msg/Clock, what a player of recorded logs publishes on /clock so that nodes run on the
+/// log's time (ROS 2's use_sim_time). Its one field, builtin_interfaces/Time, as a stamp.
+inline constexpr const char* kClockType = "rosgraph_msgs/msg/Clock";
+inline constexpr const char* kClockTopic = "/clock";
+Bytes encodeClock(Stamp time);
+/// Throws coloc::Error for a payload that is not a CDR Clock (short, unknown encapsulation, nanosec >= 1e9).
+Stamp decodeClock(const std::uint8_t* data, std::size_t size);
+
 }  // namespace coloc::io

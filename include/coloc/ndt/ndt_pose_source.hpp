@@ -19,6 +19,10 @@ struct NdtPoseSourceConfig {
   Vector6d lidar_pose = Vector6d::Zero();
 };
 
+/// Range checks of every setting, as the filter checks its own: throws coloc::Error naming the
+/// config key ("ndt.resolution: must be a finite number > 0"). NdtPoseSource's constructor calls it.
+void validate(const NdtPoseSourceConfig& config);
+
 struct NdtPoseSourceCounters {
   std::uint64_t scans = 0;
   std::uint64_t poses = 0;            ///< accepted results handed on

@@ -38,8 +38,13 @@ struct RsuInfo {
 
 class RsuRegistry {
  public:
+  RsuRegistry() = default;
+  /// From entries made in code, checked as a file's would be (throws coloc::Error naming the entry).
+  RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement);
+  /// The registry as a file that `load` reads back to the same registry.
   /// Throws coloc::Error naming the file, line and key for unknown keys, unknown LiDAR models,
   /// duplicate ids and values out of range.
+  std::string toYaml() const;
   static RsuRegistry load(const std::string& path);
   static RsuRegistry parse(const std::string& yaml_text, const std::string& source_name);
 

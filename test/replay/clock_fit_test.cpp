@@ -2,9 +2,9 @@
 
 #include <random>
 
-#include "clock_fit.hpp"
+#include "coloc/replay/clock_fit.hpp"
 
-namespace coloc::tools {
+namespace coloc::replay {
 namespace {
 
 TEST(ClockFit, RecoversRateAndOffsetOfASimulatorClockFromDelayedMessages) {
@@ -39,4 +39,4 @@ TEST(ClockFit, SingleSampleGivesRateOneAndZeroDelay) {
 }
 
 }  // namespace
-}  // namespace coloc::tools
+}  // namespace coloc::replay

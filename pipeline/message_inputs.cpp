@@ -1,4 +1,4 @@
-#include "point_cloud2_convert.hpp"
+#include "coloc/pipeline/message_inputs.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "coloc/core/error.hpp"
 
-namespace coloc::tools {
+namespace coloc::pipeline {
 
 namespace {
 
@@ -81,4 +81,69 @@ ndt::PointCloud toPointCloud(const io::PointCloud2& m) {
   return cloud;
 }
 
-}  // namespace coloc::tools
+Matrix6d completeCovariance(Matrix6d C, const Vector6d& fallback, const InputConfig* input, const MessageConfig& messages,
+                            bool& used_fallback) {
+  used_fallback = false;
+  if (input && input->covariance_diagonal) return Matrix6d(input->covariance_diagonal->asDiagonal());
+  const auto diagonal = C.diagonal();
+  const bool none = (diagonal.array() == 0.0).all() || (diagonal.array() == kInfinity).all();
+  if (none) {
+    used_fallback = true;
+    return Matrix6d(fallback.asDiagonal());
+  }
+  if (messages.zero_variance_is_unmeasured) {
+    for (int i = 0; i < 6; ++i) {
+      if (C(i, i) != 0.0) continue;
+      C.row(i).setZero();
+      C.col(i).setZero();
+      C(i, i) = kInfinity;
+    }
+  }
+  return C;
+}
+
+TwistMeasurement twistFromImu(const io::Imu& imu) {
+  TwistMeasurement t;
+  t.stamp = imu.header.stamp;
+  t.angular = imu.angular_velocity;
+  t.covariance = Matrix6d::Zero();
+  t.covariance.diagonal().head<3>().setConstant(kInfinity);  // an IMU does not measure velocity
+  t.covariance.bottomRightCorner<3, 3>() = imu.angular_velocity_covariance;
+  // REP 145: -1 in the first element says the angular velocity is not estimated.
+  if (imu.angular_velocity_covariance(0, 0) == -1.0) t.covariance.bottomRightCorner<3, 3>().diagonal().setConstant(kInfinity);
+  return t;
+}
+
+TwistMeasurement twistFromMessage(const io::RosMessage& message, const InputConfig* input, const MessageConfig& messages,
+                                  bool& used_fallback) {
+  TwistMeasurement t;
+  if (const auto* odom = std::get_if<io::Odometry>(&message)) t = odom->twist;
+  else if (const auto* st = std::get_if<io::StampedTwist>(&message)) t = st->measurement;
+  else if (const auto* imu = std::get_if<io::Imu>(&message)) t = twistFromImu(*imu);
+  else throw Error("a message of this type carries no twist");
+  t.covariance = completeCovariance(t.covariance, messages.fallback_twist_variance, input, messages, used_fallback);
+  return t;
+}
+
+PoseMeasurement poseFromMessage(const io::RosMessage& message, const InputConfig* input, const MessageConfig& messages,
+                                bool& used_fallback) {
+  PoseMeasurement p;
+  if (const auto* odom = std::get_if<io::Odometry>(&message)) p = odom->pose;
+  else if (const auto* sp = std::get_if<io::StampedPose>(&message)) p = sp->measurement;
+  else throw Error("a message of this type carries no pose");
+  p.covariance = completeCovariance(p.covariance, messages.fallback_pose_variance, input, messages, used_fallback);
+  return p;
+}
+
+rsu_client::RsuFix fixFromMessage(const io::StampedPose& message, const std::string& rsu_id) {
+  rsu_client::RsuFix fix;
+  fix.stamp = message.measurement.stamp;
+  fix.rsu_id = rsu_id;
+  fix.x = message.measurement.pose.position.x();
+  fix.y = message.measurement.pose.position.y();
+  const double yaw_variance = message.measurement.covariance(5, 5);
+  if (std::isfinite(yaw_variance) && yaw_variance > 0.0) fix.yaw = rollPitchYaw(message.measurement.pose.orientation)[2];
+  return fix;
+}
+
+}  // namespace coloc::pipeline

@@ -4,9 +4,9 @@
 #include <sstream>
 
 #include "coloc/core/error.hpp"
-#include "fuse_config.hpp"
+#include "coloc/pipeline/config.hpp"
 
-namespace coloc::tools {
+namespace coloc::pipeline {
 namespace {
 
 std::string readFile(const std::string& path) {
@@ -18,38 +18,38 @@ std::string readFile(const std::string& path) {
 
 void expectError(const std::string& yaml, const std::string& phrase) {
   try {
-    parseFuseConfig(yaml, "test.yaml");
+    parseConfig(yaml, "test.yaml");
     FAIL() << "expected an error containing '" << phrase << "'";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << e.what();
   }
 }
 
-TEST(FuseConfig, ShippedDefaultFileIsExactlyTheGeneratedDefaults) {
+TEST(Config, ShippedDefaultFileIsExactlyTheGeneratedDefaults) {
   EXPECT_EQ(readFile(COLOC_SOURCE_DIR "/config/coloc.yaml"), defaultConfigYaml())
       << "regenerate it: coloc config > config/coloc.yaml";
 }
 
-TEST(FuseConfig, ReadmeCarriesTheGeneratedReferenceTable) {
+TEST(Config, ReadmeCarriesTheGeneratedReferenceTable) {
   EXPECT_NE(readFile(COLOC_SOURCE_DIR "/README.md").find(configReferenceMarkdown()), std::string::npos)
       << "regenerate the README table: coloc config --markdown";
 }
 
-TEST(FuseConfig, DefaultYamlParsesBackToTheDefaults) {
-  const FuseConfig parsed = parseFuseConfig(defaultConfigYaml(), "defaults");
+TEST(Config, DefaultYamlParsesBackToTheDefaults) {
+  const Config parsed = parseConfig(defaultConfigYaml(), "defaults");
   EXPECT_EQ(parsed.fusion.predict_frequency, 50.0);
   EXPECT_EQ(parsed.fusion.history_steps, 50);
   EXPECT_EQ(parsed.fusion.pose_gate_alpha, 1e-10);
-  EXPECT_EQ(parsed.replay.fallback_twist_variance[1], kInfinity);
+  EXPECT_EQ(parsed.messages.fallback_twist_variance[1], kInfinity);
   EXPECT_TRUE(parsed.inputs.empty());
 }
 
-TEST(FuseConfig, EmptyTextIsTheDefaultConfiguration) {
-  EXPECT_EQ(parseFuseConfig("", "empty").fusion.pose_smoothing_steps, 5);
+TEST(Config, EmptyTextIsTheDefaultConfiguration) {
+  EXPECT_EQ(parseConfig("", "empty").fusion.pose_smoothing_steps, 5);
 }
 
-TEST(FuseConfig, ReadsInputsWithTheirRolesAndOverrides) {
-  const FuseConfig c = parseFuseConfig(
+TEST(Config, ReadsInputsWithTheirRolesAndOverrides) {
+  const Config c = parseConfig(
       "inputs:\n"
       "  /odom: {role: twist, covariance_diagonal: [0.01, .inf, .inf, .inf, .inf, 0.0025]}\n"
       "  /rsu/fix: {role: pose, source: rsu_a, additional_delay: 0.01}\n"
@@ -63,8 +63,8 @@ TEST(FuseConfig, ReadsInputsWithTheirRolesAndOverrides) {
   EXPECT_EQ(c.fusion.pose_smoothing_steps, 3);
 }
 
-TEST(FuseConfig, ReadsTheNdtSection) {
-  const FuseConfig c = parseFuseConfig("ndt:\n  backend: pcl\n  resolution: 1.0\n  max_points: 2000\n  covariance: laplace\n"
+TEST(Config, ReadsTheNdtSection) {
+  const Config c = parseConfig("ndt:\n  backend: pcl\n  resolution: 1.0\n  max_points: 2000\n  covariance: laplace\n"
                                        "  lidar_pose: [1.0, 0, 1.8, 0, 0, 0.1]\n",
                                        "test.yaml");
   EXPECT_EQ(c.ndt.source.ndt.backend, ndt::NdtBackend::kPcl);
@@ -74,39 +74,39 @@ TEST(FuseConfig, ReadsTheNdtSection) {
   EXPECT_EQ(c.ndt.source.lidar_pose[2], 1.8);
 }
 
-TEST(FuseConfig, UnknownKeysAreErrorsNamingKeyAndLine) {
+TEST(Config, UnknownKeysAreErrorsNamingKeyAndLine) {
   expectError("fusion:\n  history_step: 50\n", "test.yaml:2: fusion.history_step: unknown key");
   expectError("fusoin: {}\n", "fusoin: unknown section");
   expectError("inputs:\n  /odom: {role: twist, sigma: 1}\n", "inputs./odom.sigma: unknown key");
   expectError("replay:\n  clocks: same\n", "replay.clocks: unknown key");
 }
 
-TEST(FuseConfig, WrongTypesAndRangesAreErrorsNamingTheKey) {
+TEST(Config, WrongTypesAndRangesAreErrorsNamingTheKey) {
   expectError("fusion:\n  predict_frequency: fast\n", "fusion.predict_frequency: expected a number");
   expectError("fusion:\n  history_steps: 2.5\n", "fusion.history_steps: expected an integer");
   expectError("fusion:\n  predict_frequency: -1\n", "predict_frequency");
   expectError("fusion:\n  pose_gate_alpha: .nan\n", "must not be NaN");
-  expectError("inputs:\n  /odom: {role: velocity}\n", "expected pose, twist, ground_truth, scan or ignore");
+  expectError("inputs:\n  /odom: {role: velocity}\n", "inputs./odom.role: expected one of pose, twist, ground_truth, scan, rsu_fix, ignore");
   expectError("inputs:\n  /odom: {source: x}\n", "needs a role");
   expectError("ndt:\n  backend: gpu\n", "ndt.backend: expected one of pcl, fast, got 'gpu'");
   expectError("ndt:\n  resolution: 0\n", "ndt.resolution: must be a finite number > 0");
   expectError("ndt:\n  lidar_pose: [0, 0, 1]\n", "ndt.lidar_pose: expected 6 numbers");
   expectError("ndt:\n  voxel_sise: 1.0\n", "ndt.voxel_sise: unknown key");
-  expectError("replay:\n  initial_pose: [1, 2]\n", "replay.initial_pose: expected [x, y, z, yaw]");
+  expectError("pipeline:\n  initial_pose: [1, 2]\n", "pipeline.initial_pose: expected [x, y, z, yaw]");
   expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, 2]}\n", "expected 6 variances");
   expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, -2, 1, 1, 1, 1]}\n", "must be > 0");
-  expectError("replay:\n  clock: sometimes\n", "expected auto, same or separate");
+  expectError("replay:\n  clock: sometimes\n", "replay.clock: expected one of auto, same, separate");
   expectError("fusion: [1, 2]\n", "expected a mapping");
   expectError("fusion:\n  a: [\n", "not valid YAML");
 }
 
-TEST(FuseConfig, TwoInputsWithOneSourceNameAreAnError) {
+TEST(Config, TwoInputsWithOneSourceNameAreAnError) {
   expectError("inputs:\n  /a: {role: pose, source: x}\n  /b: {role: pose, source: x}\n", "used by two inputs");
 }
 
-TEST(FuseConfig, MissingFileIsAnErrorNamingIt) {
+TEST(Config, MissingFileIsAnErrorNamingIt) {
   try {
-    loadFuseConfig("/nonexistent/coloc.yaml");
+    loadConfig("/nonexistent/coloc.yaml");
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/coloc.yaml"), std::string::npos);
@@ -114,4 +114,4 @@ TEST(FuseConfig, MissingFileIsAnErrorNamingIt) {
 }
 
 }  // namespace
-}  // namespace coloc::tools
+}  // namespace coloc::pipeline

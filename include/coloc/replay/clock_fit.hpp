@@ -9,7 +9,7 @@
 
 #include "coloc/core/time.hpp"
 
-namespace coloc::tools {
+namespace coloc::replay {
 
 struct ClockFit {
   Stamp log_origin = 0;    ///< log time of the first point
@@ -29,4 +29,4 @@ struct ClockSample {
 /// rate 1 with the smallest delay zero.
 ClockFit fitClock(const std::vector<ClockSample>& samples);
 
-}  // namespace coloc::tools
+}  // namespace coloc::replay

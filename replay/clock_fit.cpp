@@ -1,10 +1,10 @@
-#include "clock_fit.hpp"
+#include "coloc/replay/clock_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-namespace coloc::tools {
+namespace coloc::replay {
 
 Stamp ClockFit::toStampClock(Stamp log_time) const {
   return stamp_origin + static_cast<Duration>(std::llround(rate * static_cast<double>(log_time - log_origin)));
@@ -60,4 +60,4 @@ ClockFit fitClock(const std::vector<ClockSample>& samples) {
   return fit;
 }
 
-}  // namespace coloc::tools
+}  // namespace coloc::replay

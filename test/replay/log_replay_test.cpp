@@ -9,11 +9,11 @@
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
-#include "log_replay.hpp"
+#include "coloc/replay/log_replay.hpp"
 #include "real_data.hpp"
 #include "temp_dir.hpp"
 
-namespace coloc::tools {
+namespace coloc::replay {
 namespace {
 
 std::string nav2() { return testing::realData("rosbag2/nav2_turtlebot.mcap"); }
@@ -157,7 +157,7 @@ TEST(LogReplay, TopicReplayedThroughAnEmulatedLinkIsDelayedAndThinnedRepeatably)
   testing::TempDir dir;
   const std::string log = writeSyntheticLog(dir);
   ReplayOptions options;
-  options.config = parseFuseConfig(
+  options.config = pipeline::parseConfig(
       "inputs:\n  /ndt_pose: {role: pose, link: {delay: 0.05, jitter: 0.0, loss: 0.3, seed: 5}}\n", "test.yaml");
   const ReplayResult a = replayLog(log, options), b = replayLog(log, options);
   const TopicUse& pose = topic(a, "/ndt_pose");
@@ -173,7 +173,7 @@ TEST(LogReplay, TopicReplayedThroughAnEmulatedLinkIsDelayedAndThinnedRepeatably)
 TEST(LogReplay, ConfiguredRoleOnAnIncompatibleTypeIsAnErrorNamingTheTopic) {
   testing::TempDir dir;
   ReplayOptions options;
-  options.config = parseFuseConfig("inputs:\n  /vehicle/twist: {role: pose}\n", "test.yaml");
+  options.config = pipeline::parseConfig("inputs:\n  /vehicle/twist: {role: pose}\n", "test.yaml");
   try {
     replayLog(writeSyntheticLog(dir), options);
     FAIL();
@@ -187,9 +187,9 @@ TEST(LogReplay, MissingLogIsAnErrorNamingIt) {
 }
 
 }  // namespace
-}  // namespace coloc::tools
+}  // namespace coloc::replay
 
-namespace coloc::tools {
+namespace coloc::replay {
 namespace {
 
 io::PointCloud2 toMessage(const ndt::PointCloud& cloud, Stamp stamp) {
@@ -223,7 +223,7 @@ TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   }
   ReplayOptions options;
   options.map = map;
-  options.config = parseFuseConfig("replay:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
+  options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
   const ReplayResult r = replayLog(dir / "scans", options);
   EXPECT_TRUE(r.ndt_used);
   EXPECT_EQ(topic(r, "/points").role, InputRole::kScan);
@@ -253,4 +253,4 @@ TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {
 }
 
 }  // namespace
-}  // namespace coloc::tools
+}  // namespace coloc::replay

@@ -1,0 +1,68 @@
+#pragma once
+// The vehicle pipeline live over DDS, without ROS: it subscribes to the scans, the twist, the initial
+// pose and every registered RSU's fixes with ROS 2 names, types and QoS, runs the pipeline on its own
+// thread, and publishes the fused pose (PoseWithCovarianceStamped) and odometry at every filter tick.
+// A ROS 2 system on the same DDS domain sees it as a node.
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "coloc/io/trajectory_file.hpp"
+#include "coloc/pipeline/config.hpp"
+#include "coloc/pipeline/pipeline.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+
+namespace coloc::live {
+
+struct LiveOptions {
+  pipeline::Config config;
+  std::string map;  ///< PCD file or folder of tiles; without it scans are not subscribed to
+  std::optional<rsu_client::RsuRegistry> registry;  ///< unset: the one config.rsu.registry names, if any
+  rsu_client::DdsConfig dds;
+  /// Run on the time received on /clock (rosgraph_msgs/Clock), as ROS 2 nodes with use_sim_time do
+  /// when a recorded log is played; off: the system clock.
+  bool use_sim_time = false;
+};
+
+/// What one subscribed topic brought.
+struct TopicStatus {
+  std::string topic, type;
+  std::uint64_t received = 0, undecodable = 0;
+  std::string first_error;
+};
+
+struct LiveStatus {
+  pipeline::PipelineReport report;
+  std::vector<TopicStatus> topics;
+  std::optional<fusion::Estimate> estimate;
+  std::uint64_t published = 0;  ///< estimates published
+  Stamp clock = 0;              ///< the node's time now
+  int matched_writers = 0;      ///< remote writers matched with the node's readers
+};
+
+class LiveLocalizer {
+ public:
+  /// Subscribes, advertises and starts. Throws coloc::Error for a bad map, registry or DDS setup.
+  explicit LiveLocalizer(LiveOptions options);
+  ~LiveLocalizer();
+  LiveLocalizer(const LiveLocalizer&) = delete;
+  LiveLocalizer& operator=(const LiveLocalizer&) = delete;
+
+  /// Stops the pipeline (what arrived still counts); nothing is published afterwards.
+  void stop();
+  LiveStatus status() const;
+  /// Every estimate published so far, for fused.tum.
+  std::vector<io::TrajectoryPoint> trajectory() const;
+  /// summary.json in the shape `coloc fuse` writes: topics, sources, NDT, fixes, rejections.
+  std::string summaryJson() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace coloc::live

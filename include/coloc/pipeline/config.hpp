@@ -1,0 +1,110 @@
+#pragma once
+// coloc's configuration file, one for every use (`coloc fuse`, `coloc localize`, a linked pipeline):
+// the filter (`fusion:`), scan matching (`ndt:`), roadside fixes (`rsu:`), the pipeline itself
+// (`pipeline:`), how messages become measurements (`messages:`), what each topic is for (`inputs:`),
+// offline replay (`replay:`) and the live node's topics (`live:`). Every key has a default, so an
+// empty file (or none) is a valid configuration; the defaults live here and nowhere else.
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "coloc/core/types.hpp"
+#include "coloc/fusion/ekf_config.hpp"
+#include "coloc/ndt/ndt_pose_source.hpp"
+#include "coloc/rsu_client/link_emulator.hpp"
+#include "coloc/rsu_client/rsu_fix.hpp"
+
+namespace coloc::pipeline {
+
+enum class InputRole { kPose, kTwist, kGroundTruth, kScan, kRsuFix, kIgnore };
+const char* toString(InputRole role);
+
+/// How one topic is used. Topics not listed are chosen by message type (see README).
+struct InputConfig {
+  InputRole role = InputRole::kIgnore;
+  std::string source;                      ///< name in the Localizer; default: the topic
+  std::optional<Vector6d> covariance_diagonal;  ///< replaces the message's covariance (not for rsu_fix: the registry decides)
+  double additional_delay = 0.0;           ///< s; the data was sensed this much before its stamp
+  /// Replays the topic through an emulated radio link (delay, jitter, loss), as experiments do.
+  std::optional<rsu_client::LinkConfig> link;
+};
+
+enum class ClockMode { kAuto, kSame, kSeparate };
+
+/// How decoded messages become measurements, live and offline alike.
+struct MessageConfig {
+  /// ROS drivers write 0 for components they do not estimate (AMCL's z, roll, pitch); read as +inf.
+  bool zero_variance_is_unmeasured = true;
+  /// Used when a message carries no covariance at all (PoseStamped, or all zeros): Autoware's NDT value.
+  Vector6d fallback_pose_variance = (Vector6d() << 0.0225, 0.0225, 0.0225, 0.000625, 0.000625, 0.000625).finished();
+  /// Autoware's twist standard deviations 0.2 m/s and 0.1 rad/s; vy, vz, wx, wy are not used.
+  Vector6d fallback_twist_variance = (Vector6d() << 0.04, kInfinity, kInfinity, kInfinity, kInfinity, 0.01).finished();
+};
+
+struct ReplayConfig {
+  /// Whether header stamps and log (receive) times are on one clock. `separate` (a log recorded with
+  /// simulation time) measures each message's delay relative to the least-delayed message.
+  ClockMode clock = ClockMode::kAuto;
+  /// Ground truth further than this from an output tick is not interpolated across.
+  double ground_truth_max_gap = 0.2;  ///< s
+};
+
+/// Scan matching of a PointCloud2 topic against a map (`--map`).
+struct NdtSection {
+  ndt::NdtPoseSourceConfig source;
+  double map_tile_size = 20.0;  ///< m; a single-file map is cut into squares of this size
+};
+
+/// Roadside fixes: which RSUs are trusted and how fresh a fix must be.
+struct RsuSection {
+  /// RSU registry file (relative paths from the configuration file's folder); none: fix topics are
+  /// plain pose inputs offline and there is nothing to subscribe to live.
+  std::string registry;
+  rsu_client::FixCheckConfig checks;
+};
+
+struct PipelineSection {
+  /// Starts the filter here (x, y, z [m], yaw [rad]) at the first input, for runs whose only pose
+  /// source is NDT, which needs a first guess.
+  std::optional<Eigen::Vector4d> initial_pose;
+};
+
+/// The live node's topics (ROS 2 names; DDS adds "rt") and QoS.
+struct LiveSection {
+  std::string scan_topic = "/points";
+  std::string twist_topic = "/vehicle/twist";
+  std::string twist_type = "geometry_msgs/msg/TwistWithCovarianceStamped";  ///< or nav_msgs/msg/Odometry, sensor_msgs/msg/Imu
+  std::string initial_pose_topic = "/initialpose";  ///< PoseWithCovarianceStamped, as RViz sends it
+  std::string pose_topic = "/localization/pose_twist_fusion_filter/pose_with_covariance";
+  std::string odometry_topic = "/localization/pose_twist_fusion_filter/kinematic_state";
+  std::string frame_id = "map";
+  std::string child_frame_id = "base_link";
+  bool reliable = false;  ///< false: ROS 2 sensor-data QoS (best effort) on the inputs
+};
+
+struct Config {
+  fusion::EkfConfig fusion;
+  NdtSection ndt;
+  RsuSection rsu;
+  PipelineSection pipeline;
+  MessageConfig messages;
+  std::map<std::string, InputConfig> inputs;  ///< by topic
+  ReplayConfig replay;
+  LiveSection live;
+};
+
+/// Loads and validates a YAML file. Unknown keys, wrong types and out-of-range values throw
+/// coloc::Error naming the file, the key and the line. A relative rsu.registry is made relative to
+/// the file's folder.
+Config loadConfig(const std::string& path);
+Config parseConfig(const std::string& yaml_text, const std::string& source_name);
+
+/// The complete default configuration as YAML with a comment per key: `coloc config` prints it and
+/// config/coloc.yaml is this text.
+std::string defaultConfigYaml();
+
+/// The README's reference table (Markdown) of every key.
+std::string configReferenceMarkdown();
+
+}  // namespace coloc::pipeline

@@ -1,0 +1,112 @@
+#pragma once
+// The vehicle loop, as one object a vehicle stack links: scans go to NDT with the filter's prediction
+// for their stamp as the initial guess, roadside fixes pass the registry's checks, twists and other
+// poses go straight in, and the estimate comes out at every filter tick.
+//
+// Inputs may be pushed from any thread (DDS or driver callbacks): they only enter a thread-safe inbox,
+// as Autoware's EKF node only queues what its callbacks receive. The inbox is drained in arrival order
+// at the filter's ticks, either by `runUntil` on the caller's clock (offline: log time, so that a run
+// repeats exactly) or by the pipeline's own thread on the system clock (`start`, live). Live, NDT runs
+// on a thread of its own so that ticks keep their pace; its pose enters the inbox when it is done and
+// the filter compensates the matching time like any other delay.
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "coloc/core/types.hpp"
+#include "coloc/fusion/localizer.hpp"
+#include "coloc/ndt/ndt_pose_source.hpp"
+#include "coloc/ndt/point_cloud.hpp"
+#include "coloc/pipeline/config.hpp"
+#include "coloc/rsu_client/rsu_fix.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+
+namespace coloc::pipeline {
+
+struct PipelineOptions {
+  /// The map NDT matches scans against; none: scans are counted and dropped.
+  std::optional<ndt::TileMap> map;
+  /// The RSUs whose fixes are accepted; none: fixes are counted as unknown_rsu.
+  std::optional<rsu_client::RsuRegistry> registry;
+  /// Live: NDT on its own thread (a scan that arrives while one is matched replaces the waiting one,
+  /// counted). Offline: inline, so that the same log gives the same bytes.
+  bool ndt_thread = false;
+  /// Live: the clock the pipeline's thread runs on and NDT's results arrive by; unset: the system
+  /// clock. A node on a recorded log's time (ROS 2's use_sim_time) gives the /clock it receives.
+  std::function<Stamp()> clock;
+};
+
+/// What the pipeline has done so far: per-source filter counters, NDT, fixes, rejections.
+struct PipelineReport {
+  std::vector<fusion::SourceReport> sources;
+  std::uint64_t unknown_source_inputs = 0;
+  std::uint64_t ticks = 0;                   ///< estimates given out
+  bool ndt_used = false;
+  ndt::NdtPoseSourceCounters ndt;
+  ndt::DynamicMapStats map;
+  std::uint64_t scans_without_guess = 0;     ///< before the filter could predict their pose
+  std::uint64_t scans_without_map = 0;       ///< no map given
+  std::uint64_t scans_superseded = 0;        ///< live: replaced by a newer scan while NDT was busy
+  std::map<std::string, rsu_client::FixCounters> fixes;  ///< per RSU id
+  std::uint64_t rejections = 0;              ///< every refusal, of any kind
+  std::vector<std::string> first_rejections; ///< the first few, as one line each
+};
+
+/// The name under which the filter counts NDT's poses.
+inline constexpr const char* kNdtSource = "ndt";
+
+class Pipeline {
+ public:
+  /// Throws coloc::Error naming the key for an invalid configuration.
+  Pipeline(const Config& config, PipelineOptions options);
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  /// Registers an input source by name (a topic, say); call before feeding it. The RSUs of the
+  /// registry and NDT ("ndt") are registered by the pipeline. Thread-safe.
+  fusion::SourceId addPoseSource(const std::string& name);
+  fusion::SourceId addTwistSource(const std::string& name);
+  /// The filter's source of an RSU's fixes (its fix topic), if the registry has it.
+  std::optional<fusion::SourceId> fixSource(const std::string& rsu_id) const;
+
+  // Inputs, from any thread. `arrival` is when the input reached the vehicle, on the clock the
+  // pipeline runs on (the system clock live, log time offline).
+  void pushScan(ndt::PointCloud scan, Stamp stamp, Stamp arrival);
+  void pushTwist(fusion::SourceId source, const TwistMeasurement& twist, Stamp arrival);
+  void pushPose(fusion::SourceId source, const PoseMeasurement& pose, Stamp arrival);
+  void pushFix(const rsu_client::RsuFix& fix, Stamp arrival);
+  /// Starts (or restarts) the filter at this pose, in arrival order with the other inputs.
+  void pushInitialPose(const PoseMeasurement& pose, Stamp arrival);
+
+  // Outputs. Set them before the first input; they are called on the thread that drains the inbox.
+  /// Every new estimate: each filter tick, and the first estimate after a pose starts the filter.
+  void onEstimate(std::function<void(const fusion::Estimate&)> callback);
+  /// Every pose measurement handed to the filter (NDT results, fixes, other sources), for plots.
+  void onPoseInput(std::function<void(const std::string& source, const PoseMeasurement&)> callback);
+  /// Every rejection, as one line naming the input and the reason.
+  void onRejection(std::function<void(const std::string& line)> callback);
+
+  /// Offline: processes every input that arrived by `now` in arrival order (ties in push order),
+  /// running the filter's ticks up to each input's arrival, then up to `now`.
+  void runUntil(Stamp now);
+
+  /// Live: a thread that drains the inbox at the filter's rate on the system clock. `stop` drains
+  /// what has arrived and joins the threads; the destructor stops too.
+  void start();
+  void stop();
+
+  /// A snapshot; thread-safe.
+  PipelineReport report() const;
+  /// The newest estimate; thread-safe.
+  std::optional<fusion::Estimate> estimate() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace coloc::pipeline

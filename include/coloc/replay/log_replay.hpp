@@ -1,0 +1,70 @@
+#pragma once
+// Offline fusion of a recorded log through the vehicle pipeline, in stages a reader can follow:
+//   1. topic plan   which topic feeds what (by the config, else by message type)      topic_plan.hpp
+//   2. decode       every message of a used topic into a pipeline input
+//   3. clock        arrival times on the stamp clock (fitted when the clocks differ)    clock_fit.hpp
+//   4. link         topics replayed through an emulated radio link are delayed or lost
+//   5. drive        the inputs pushed into a Pipeline in arrival order, its clock driven by log time
+//   6. evaluation   the estimate at every tick against the log's ground truth          evaluation.hpp
+// What the filter held at each tick is what a vehicle would have had at that moment, and the same
+// log and config always give the same bytes.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "coloc/fusion/localizer.hpp"
+#include "coloc/io/trajectory_file.hpp"
+#include "coloc/ndt/ndt_pose_source.hpp"
+#include "coloc/pipeline/config.hpp"
+#include "coloc/pipeline/pipeline.hpp"
+#include "coloc/replay/clock_fit.hpp"
+#include "coloc/replay/evaluation.hpp"
+#include "coloc/replay/topic_plan.hpp"
+#include "coloc/rsu_client/rsu_registry.hpp"
+
+namespace coloc::replay {
+
+using pipeline::ClockMode;
+using pipeline::InputRole;
+
+struct ReplayResult {
+  std::vector<TopicUse> topics;
+  std::vector<fusion::SourceReport> sources;
+  std::uint64_t unknown_source_inputs = 0;
+  std::vector<io::TrajectoryPoint> fused;          ///< the estimate at every tick
+  std::vector<io::TrajectoryPoint> pose_inputs;    ///< every pose measurement fed (NDT, fixes, others), for plots
+  std::vector<io::TrajectoryPoint> ground_truth;
+  std::vector<ErrorSample> errors;                 ///< at ticks with ground truth
+  ClockMode clock = ClockMode::kAuto;              ///< the mode used (never kAuto)
+  ClockFit clock_fit;                              ///< log time -> stamp clock, when the clocks are separate
+  Stamp first_stamp = 0, last_stamp = 0;           ///< span of the replay on the stamp clock
+  double log_duration = 0.0;                       ///< s of log time
+  double wall_seconds = 0.0;                       ///< replay time, decoding included
+  std::uint64_t messages_read = 0;
+  std::vector<std::string> rejections;             ///< the first few rejection messages, for the summary
+  bool ndt_used = false;
+  ndt::NdtPoseSourceCounters ndt;                  ///< scan matching, when a map was given
+  std::uint64_t scans_without_guess = 0;           ///< scans before the filter could predict their pose
+  ndt::DynamicMapStats map;
+  std::map<std::string, rsu_client::FixCounters> fixes;  ///< roadside fixes per RSU, when a registry was given
+
+  /// Everything that follows from the log and the config, as JSON (summary.json of `coloc fuse`): the
+  /// same log and config give the same bytes. `log` is the name to print for the recording.
+  std::string summaryJson(const std::string& log) const;
+  /// error.csv: the planar error at every tick with ground truth.
+  void writeErrorCsv(const std::string& path) const;
+  ErrorStats errorStats() const { return replay::errorStats(errors); }
+};
+
+struct ReplayOptions {
+  pipeline::Config config;
+  std::string map;  ///< PCD file or folder of tiles; with it, PointCloud2 topics feed NDT
+  /// The RSUs whose fixes are trusted; unset: the one config.rsu.registry names, if any.
+  std::optional<rsu_client::RsuRegistry> registry;
+  std::function<void(double fraction)> progress;  ///< called now and then with 0..1
+};
+
+/// Throws coloc::Error if the log cannot be read at all; bad messages inside it are counted, not fatal.
+ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options);
+
+}  // namespace coloc::replay

@@ -1,0 +1,64 @@
+#pragma once
+// A DDS participant that moves ROS 2 messages as serialized CDR, whatever their type, the way ROS 2
+// puts them on the wire: topic "rt" + ROS name, type "pkg::msg::dds_::Name_". The bytes are exactly
+// what rosbag2 records (encapsulation header first), so a recorded log can be published as it is and a
+// received sample decoded by coloc's own codecs. No Fast DDS type appears in this header.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coloc/core/time.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
+
+namespace coloc::rsu_client {
+
+/// "sensor_msgs/msg/PointCloud2" -> "sensor_msgs::msg::dds_::PointCloud2_", as rmw_fastrtps names types.
+std::string ddsTypeName(const std::string& ros_type);
+
+struct TopicQos {
+  bool reliable = false;          ///< false: best effort (ROS 2 sensor data)
+  int depth = 5;                  ///< keep-last depth
+  bool transient_local = false;   ///< late joiners get the last samples (ROS 2 /tf_static, maps)
+};
+
+class DdsNode {
+ public:
+  /// Throws coloc::Error if DDS refuses the participant (bad security files, ...).
+  explicit DdsNode(const DdsConfig& config);
+  ~DdsNode();
+  DdsNode(const DdsNode&) = delete;
+  DdsNode& operator=(const DdsNode&) = delete;
+
+  class Writer {
+   public:
+    /// Writes one serialized message (CDR with its 4-byte encapsulation header). False if DDS refused.
+    bool write(const std::uint8_t* data, std::size_t size);
+    bool write(const std::vector<std::uint8_t>& bytes) { return write(bytes.data(), bytes.size()); }
+    int matchedReaders() const;
+
+   private:
+    friend class DdsNode;
+    struct Impl;
+    std::shared_ptr<Impl> impl_;
+  };
+
+  /// A writer on a ROS topic of a ROS type. Throws coloc::Error if DDS refuses it.
+  Writer advertise(const std::string& ros_topic, const std::string& ros_type, const TopicQos& qos);
+
+  /// Called on a DDS thread with each sample's bytes and its arrival (systemNow()). The callback must
+  /// not throw; whatever it cannot use it counts.
+  using Callback = std::function<void(std::vector<std::uint8_t>&& bytes, Stamp received)>;
+  /// Subscribes to a ROS topic of a ROS type. Throws coloc::Error if DDS refuses.
+  void subscribe(const std::string& ros_topic, const std::string& ros_type, const TopicQos& qos, Callback callback);
+
+  /// Remote writers currently matched with this node's readers, all topics together.
+  int matchedWriters() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace coloc::rsu_client

@@ -1,0 +1,239 @@
+#include "coloc/live/live_localizer.hpp"
+
+#include <atomic>
+#include <mutex>
+#include <nlohmann/json.hpp>
+
+#include "coloc/core/error.hpp"
+#include "coloc/io/ros_messages.hpp"
+#include "coloc/pipeline/message_inputs.hpp"
+#include "coloc/pipeline/report_json.hpp"
+#include "coloc/rsu_client/dds_node.hpp"
+
+namespace coloc::live {
+
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+rsu_client::TopicQos inputQos(const pipeline::Config& c, int depth) {
+  rsu_client::TopicQos q;
+  q.reliable = c.live.reliable;
+  q.depth = depth;
+  return q;
+}
+
+}  // namespace
+
+struct LiveLocalizer::Impl {
+  pipeline::Config config;
+  bool use_sim_time = false;
+  std::atomic<Stamp> sim_now{0};
+  std::atomic<bool> stopped{false};
+
+  mutable std::mutex mutex;  // topics, trajectory
+  std::vector<TopicStatus> topics;
+  std::vector<io::TrajectoryPoint> trajectory;
+  std::atomic<std::uint64_t> published{0};
+
+  std::unique_ptr<pipeline::Pipeline> pipe;
+  std::unique_ptr<rsu_client::DdsNode> node;  // after the pipeline: destroyed first, so no callback outlives it
+  rsu_client::DdsNode::Writer pose_writer, odometry_writer;
+
+  Stamp now() const { return use_sim_time ? sim_now.load() : rsu_client::systemNow(); }
+
+  std::size_t addTopic(const std::string& topic, const std::string& type) {
+    std::lock_guard<std::mutex> lock(mutex);
+    topics.push_back({topic, type, 0, 0, {}});
+    return topics.size() - 1;
+  }
+
+  // Decodes and pushes one sample; whatever goes wrong is counted against its topic, never thrown
+  // into DDS's thread.
+  template <typename Use>
+  void receive(std::size_t topic, const Bytes& bytes, Use use) {
+    const Stamp arrival = now();
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      ++topics[topic].received;
+    }
+    if (stopped.load()) return;
+    try {
+      use(bytes, arrival);
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (topics[topic].undecodable++ == 0) topics[topic].first_error = topics[topic].topic + ": " + e.what();
+    }
+  }
+
+  void publish(const fusion::Estimate& e) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      trajectory.push_back({e.stamp, e.pose});
+    }
+    if (stopped.load()) return;
+    try {
+      io::StampedPose pose;
+      pose.header = {e.stamp, config.live.frame_id};
+      pose.measurement.stamp = e.stamp;
+      pose.measurement.pose = e.pose;
+      pose.measurement.covariance = e.pose_covariance;
+      pose_writer.write(io::encodePoseWithCovarianceStamped(pose));
+      io::Odometry odom;
+      odom.header = {e.stamp, config.live.frame_id};
+      odom.child_frame_id = config.live.child_frame_id;
+      odom.pose = pose.measurement;
+      odom.twist.stamp = e.stamp;
+      odom.twist.linear = e.linear_velocity;
+      odom.twist.angular = e.angular_velocity;
+      odom.twist.covariance = e.twist_covariance;
+      odometry_writer.write(io::encodeOdometry(odom));
+      ++published;
+    } catch (const std::exception&) {
+      // An estimate that cannot be encoded (a stamp beyond int32 seconds) is kept in the trajectory only.
+    }
+  }
+};
+
+LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& d = *impl_;
+  d.config = options.config;
+  d.use_sim_time = options.use_sim_time;
+  if (!options.registry && !d.config.rsu.registry.empty()) options.registry = rsu_client::RsuRegistry::load(d.config.rsu.registry);
+  std::vector<std::string> rsu_ids;
+  if (options.registry)
+    for (const auto& r : options.registry->rsus()) rsu_ids.push_back(r.id);
+
+  pipeline::PipelineOptions po;
+  if (!options.map.empty()) po.map = ndt::TileMap::open(options.map, d.config.ndt.map_tile_size);
+  const bool have_map = po.map.has_value();
+  po.registry = std::move(options.registry);
+  po.ndt_thread = true;
+  po.clock = [&d] { return d.now(); };
+  d.pipe = std::make_unique<pipeline::Pipeline>(d.config, std::move(po));
+  d.pipe->onEstimate([&d](const fusion::Estimate& e) { d.publish(e); });
+  const fusion::SourceId twist_source = d.pipe->addTwistSource(d.config.live.twist_topic);
+
+  d.node = std::make_unique<rsu_client::DdsNode>(options.dds);
+  rsu_client::TopicQos out_qos;
+  out_qos.reliable = true;  // as Autoware's EKF publishes: reliable readers and best-effort ones both match
+  out_qos.depth = 10;
+  d.pose_writer = d.node->advertise(d.config.live.pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
+  d.odometry_writer = d.node->advertise(d.config.live.odometry_topic, "nav_msgs/msg/Odometry", out_qos);
+
+  if (d.use_sim_time) {
+    const std::size_t t = d.addTopic(io::kClockTopic, io::kClockType);
+    rsu_client::TopicQos clock_qos;
+    clock_qos.depth = 1;
+    d.node->subscribe(io::kClockTopic, io::kClockType, clock_qos, [&d, t](Bytes&& b, Stamp) {
+      d.receive(t, b, [&d](const Bytes& bytes, Stamp) {
+        const Stamp time = io::decodeClock(bytes.data(), bytes.size());
+        Stamp previous = d.sim_now.load();
+        while (time > previous && !d.sim_now.compare_exchange_weak(previous, time)) {
+        }
+      });
+    });
+  }
+  if (have_map) {
+    const std::size_t t = d.addTopic(d.config.live.scan_topic, "sensor_msgs/msg/PointCloud2");
+    d.node->subscribe(d.config.live.scan_topic, "sensor_msgs/msg/PointCloud2", inputQos(d.config, 5), [&d, t](Bytes&& b, Stamp) {
+      d.receive(t, b, [&d](const Bytes& bytes, Stamp arrival) {
+        const io::PointCloud2 cloud = io::decodePointCloud2(bytes.data(), bytes.size());
+        d.pipe->pushScan(pipeline::toPointCloud(cloud), cloud.header.stamp, arrival);
+      });
+    });
+  }
+  {
+    const auto kind = io::messageKindOf(d.config.live.twist_type);
+    if (!kind) throw Error("live.twist_type: coloc cannot decode " + d.config.live.twist_type);
+    const std::size_t t = d.addTopic(d.config.live.twist_topic, d.config.live.twist_type);
+    d.node->subscribe(d.config.live.twist_topic, d.config.live.twist_type, inputQos(d.config, 50),
+                      [&d, t, kind = *kind, twist_source](Bytes&& b, Stamp) {
+                        d.receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
+                          bool fallback = false;
+                          const TwistMeasurement twist =
+                              pipeline::twistFromMessage(io::decodeMessage(kind, bytes), nullptr, d.config.messages, fallback);
+                          d.pipe->pushTwist(twist_source, twist, arrival);
+                        });
+                      });
+  }
+  if (!d.config.live.initial_pose_topic.empty()) {
+    const std::size_t t = d.addTopic(d.config.live.initial_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped");
+    d.node->subscribe(d.config.live.initial_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", inputQos(d.config, 1),
+                      [&d, t](Bytes&& b, Stamp) {
+                        d.receive(t, b, [&d](const Bytes& bytes, Stamp arrival) {
+                          bool fallback = false;
+                          const PoseMeasurement pose = pipeline::poseFromMessage(
+                              io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, bytes), nullptr, d.config.messages, fallback);
+                          d.pipe->pushInitialPose(pose, arrival);
+                        });
+                      });
+  }
+  for (const std::string& id : rsu_ids) {
+    const std::string topic = rsu_client::fixTopic(id);
+    const std::size_t t = d.addTopic(topic, "geometry_msgs/msg/PoseWithCovarianceStamped");
+    d.node->subscribe(topic, "geometry_msgs/msg/PoseWithCovarianceStamped", inputQos(d.config, 5), [&d, t, id](Bytes&& b, Stamp) {
+      d.receive(t, b, [&d, &id](const Bytes& bytes, Stamp arrival) {
+        d.pipe->pushFix(pipeline::fixFromMessage(io::decodePoseWithCovarianceStamped(bytes), id), arrival);
+      });
+    });
+  }
+  d.pipe->start();
+}
+
+LiveLocalizer::~LiveLocalizer() {
+  stop();
+  impl_->node.reset();  // DDS first: no callback may reach a pipeline that is gone
+}
+
+void LiveLocalizer::stop() {
+  impl_->pipe->stop();
+  impl_->stopped = true;
+}
+
+LiveStatus LiveLocalizer::status() const {
+  LiveStatus s;
+  s.report = impl_->pipe->report();
+  s.estimate = impl_->pipe->estimate();
+  s.published = impl_->published.load();
+  s.clock = impl_->now();
+  s.matched_writers = impl_->node ? impl_->node->matchedWriters() : 0;
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  s.topics = impl_->topics;
+  return s;
+}
+
+std::vector<io::TrajectoryPoint> LiveLocalizer::trajectory() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->trajectory;
+}
+
+std::string LiveLocalizer::summaryJson() const {
+  const LiveStatus s = status();
+  const std::vector<io::TrajectoryPoint> fused = trajectory();
+  nlohmann::ordered_json j;
+  j["mode"] = "live";
+  j["clock"] = impl_->use_sim_time ? "/clock (simulation time)" : "system";
+  auto& topics = j["topics"] = nlohmann::ordered_json::array();
+  for (const TopicStatus& t : s.topics) {
+    nlohmann::ordered_json o = {{"topic", t.topic}, {"type", t.type}, {"messages", t.received}, {"decode_errors", t.undecodable}};
+    if (!t.first_error.empty()) o["first_error"] = t.first_error;
+    topics.push_back(o);
+  }
+  j["sources"] = nlohmann::ordered_json::parse(pipeline::sourcesJson(s.report.sources));
+  j["fused"] = {{"file", "fused.tum"},
+                {"poses", fused.size()},
+                {"published", s.published},
+                {"first_stamp", formatSeconds(fused.empty() ? 0 : fused.front().stamp)},
+                {"last_stamp", formatSeconds(fused.empty() ? 0 : fused.back().stamp)}};
+  if (s.report.ndt_used) {
+    j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(s.report.ndt, s.report.map, s.report.scans_without_guess));
+    j["ndt"]["scans_superseded"] = s.report.scans_superseded;
+  }
+  if (!s.report.fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(s.report.fixes));
+  j["rejections"] = s.report.rejections;
+  j["rejections_first"] = s.report.first_rejections;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace coloc::live

@@ -1,0 +1,416 @@
+#include "coloc/pipeline/config.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <type_traits>
+
+#include "coloc/core/error.hpp"
+#include "coloc/core/yaml_reader.hpp"
+#include "coloc/fusion/ekf_params.hpp"
+#include "coloc/fusion/localizer.hpp"
+#include "coloc/io/ros_messages.hpp"
+
+namespace coloc::pipeline {
+
+const char* toString(InputRole role) {
+  switch (role) {
+    case InputRole::kPose: return "pose";
+    case InputRole::kTwist: return "twist";
+    case InputRole::kGroundTruth: return "ground_truth";
+    case InputRole::kScan: return "scan";
+    case InputRole::kRsuFix: return "rsu_fix";
+    case InputRole::kIgnore: return "ignore";
+  }
+  return "?";
+}
+
+namespace {
+
+const char* toString(ClockMode mode) {
+  switch (mode) {
+    case ClockMode::kAuto: return "auto";
+    case ClockMode::kSame: return "same";
+    case ClockMode::kSeparate: return "separate";
+  }
+  return "?";
+}
+
+std::string yamlNumber(double v) {
+  if (v == kInfinity) return ".inf";
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+template <typename Vector>
+std::string yamlList(const Vector& v) {
+  std::string s = "[";
+  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + yamlNumber(v[i]);
+  return s + "]";
+}
+
+template <typename T>
+std::string show(T v) {
+  std::ostringstream out;
+  out << v;
+  std::string text = out.str();
+  if constexpr (std::is_floating_point_v<T>)
+    if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string quoted(const std::string& s) { return s.empty() ? std::string("null") : "\"" + s + "\""; }
+
+void readFusion(const YamlReader& r, const YAML::Node& node, fusion::EkfConfig& config) {
+  r.requireMap(node, "fusion");
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const fusion::EkfParam* param = nullptr;
+    for (const auto& p : fusion::ekfParams())
+      if (key == p.key) param = &p;
+    if (!param) r.fail(entry.first, "fusion." + key, "unknown key (see `coloc config` for the valid ones)");
+    const std::string full = "fusion." + key;
+    if (const auto* d = std::get_if<double fusion::EkfConfig::*>(&param->field)) {
+      config.*(*d) = r.number(entry.second, full);
+    } else if (const auto* i = std::get_if<int fusion::EkfConfig::*>(&param->field)) {
+      config.*(*i) = static_cast<int>(r.integer(entry.second, full, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+    } else {
+      config.*std::get<bool fusion::EkfConfig::*>(param->field) = r.flag(entry.second, full);
+    }
+  }
+  try {
+    fusion::Localizer probe(config);  // the filter's own range checks, reported against the file
+  } catch (const Error& e) {
+    r.fail(node, "fusion", e.what());
+  }
+}
+
+Vector6d readVariances(const YamlReader& r, const YAML::Node& node, const std::string& key) {
+  const std::vector<double> v =
+      r.numbers(node, key, 6, "6 variances [x, y, z, roll, pitch, yaw] or [vx, vy, vz, wx, wy, wz]; .inf = not measured");
+  for (int i = 0; i < 6; ++i)
+    if (!(v[i] > 0.0)) r.fail(node[i], key, "variances must be > 0 (.inf for not measured)");
+  return Eigen::Map<const Vector6d>(v.data());
+}
+
+rsu_client::LinkConfig readLink(const YamlReader& r, const YAML::Node& node, const std::string& where) {
+  r.allowKeys(node, where, {"delay", "jitter", "loss", "burst", "p_good_to_bad", "p_bad_to_good", "loss_in_good", "loss_in_bad", "seed"});
+  rsu_client::LinkConfig link;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const std::string full = where + "." + key;
+    const YAML::Node& v = entry.second;
+    if (key == "delay") link.delay = r.inRange(v, full, 0.0, 10.0);
+    else if (key == "jitter") link.jitter = r.inRange(v, full, 0.0, 10.0);
+    else if (key == "loss") link.loss = r.probability(v, full);
+    else if (key == "burst") link.burst = r.flag(v, full);
+    else if (key == "p_good_to_bad") link.p_good_to_bad = r.probability(v, full);
+    else if (key == "p_bad_to_good") link.p_bad_to_good = r.probability(v, full);
+    else if (key == "loss_in_good") link.loss_in_good = r.probability(v, full);
+    else if (key == "loss_in_bad") link.loss_in_bad = r.probability(v, full);
+    else link.seed = static_cast<std::uint64_t>(r.integer(v, full, 0, std::numeric_limits<long long>::max()));
+  }
+  return link;
+}
+
+InputConfig readInput(const YamlReader& r, const std::string& topic, const YAML::Node& node) {
+  const std::string where = "inputs." + topic;
+  r.allowKeys(node, where, {"role", "source", "covariance_diagonal", "additional_delay", "link"});
+  InputConfig input;
+  bool has_role = false;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const std::string full = where + "." + key;
+    if (key == "role") {
+      const std::string role = r.choice(entry.second, full, {"pose", "twist", "ground_truth", "scan", "rsu_fix", "ignore"});
+      for (InputRole candidate : {InputRole::kPose, InputRole::kTwist, InputRole::kGroundTruth, InputRole::kScan, InputRole::kRsuFix, InputRole::kIgnore})
+        if (role == toString(candidate)) input.role = candidate;
+      has_role = true;
+    } else if (key == "source") {
+      input.source = r.text(entry.second, full);
+    } else if (key == "covariance_diagonal") {
+      input.covariance_diagonal = readVariances(r, entry.second, full);
+    } else if (key == "additional_delay") {
+      input.additional_delay = r.inRange(entry.second, full, 0.0, 10.0);
+    } else {
+      input.link = readLink(r, entry.second, full);
+    }
+  }
+  if (!has_role) r.fail(node, where, "needs a role: pose, twist, ground_truth, scan, rsu_fix or ignore");
+  if (input.source.empty()) input.source = topic;
+  return input;
+}
+
+// The keys of the plain sections, one row each: reader and writer side by side so that they cannot
+// drift apart, and the documentation beside them.
+struct Key {
+  const char* section;
+  const char* key;
+  const char* unit;
+  const char* meaning;
+  std::string (*get)(const Config&);
+  void (*set)(const YamlReader&, const YAML::Node&, const std::string&, Config&);
+};
+
+using R = YamlReader;
+using N = YAML::Node;
+using S = std::string;
+using C = Config;
+
+const std::vector<Key>& keys() {
+  using namespace coloc::ndt;
+  static const std::vector<Key> table = {
+      // ---- ndt: types here; ranges are ndt's own checks (ndt::validate)
+      {"ndt", "backend", "", "pcl (stock pcl::NormalDistributionsTransform) or fast (coloc's aligner on PCL's voxel grid)",
+       [](const C& c) { return S(c.ndt.source.ndt.backend == NdtBackend::kPcl ? "pcl" : "fast"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.backend = r.choice(n, k, {"pcl", "fast"}) == "pcl" ? NdtBackend::kPcl : NdtBackend::kFast; }},
+      {"ndt", "neighborhood", "", "fast backend voxels per point: radius (as PCL), face7 or single",
+       [](const C& c) { const auto h = c.ndt.source.ndt.neighborhood; return S(h == Neighborhood::kRadius ? "radius" : h == Neighborhood::kFace7 ? "face7" : "single"); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         const S v = r.choice(n, k, {"radius", "face7", "single"});
+         c.ndt.source.ndt.neighborhood = v == "radius" ? Neighborhood::kRadius : v == "face7" ? Neighborhood::kFace7 : Neighborhood::kSingle; }},
+      {"ndt", "resolution", "m", "NDT voxel size of the map", [](const C& c) { return show(c.ndt.source.ndt.resolution); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.resolution = r.number(n, k); }},
+      {"ndt", "step_size", "m", "longest Newton step", [](const C& c) { return show(c.ndt.source.ndt.step_size); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.step_size = r.number(n, k); }},
+      {"ndt", "transformation_epsilon", "m^2", "stop when the squared translation of a step is below this (PCL's meaning; Autoware's 0.01 is 1e-4 here)",
+       [](const C& c) { return show(c.ndt.source.ndt.transformation_epsilon); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.transformation_epsilon = r.number(n, k); }},
+      {"ndt", "max_iterations", "", "iteration limit; a result that reaches it is rejected", [](const C& c) { return show(c.ndt.source.ndt.max_iterations); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.max_iterations = static_cast<int>(r.integer(n, k, -1000000, 1000000)); }},
+      {"ndt", "outlier_ratio", "", "share of points the score treats as outliers", [](const C& c) { return show(c.ndt.source.ndt.outlier_ratio); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.outlier_ratio = r.number(n, k); }},
+      {"ndt", "threads", "", "fast backend threads; 0 = all cores", [](const C& c) { return show(c.ndt.source.ndt.threads); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.threads = static_cast<int>(r.integer(n, k, -1000000, 1000000)); }},
+      {"ndt", "nvtl_threshold", "", "results with a lower nearest-voxel transformation likelihood are rejected", [](const C& c) { return show(c.ndt.source.ndt.nvtl_threshold); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.nvtl_threshold = r.number(n, k); }},
+      {"ndt", "max_oscillations", "", "steps reversing direction before a result is rejected", [](const C& c) { return show(c.ndt.source.ndt.max_oscillations); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.max_oscillations = static_cast<int>(r.integer(n, k, -1000000, 1000000)); }},
+      {"ndt", "covariance", "", "fixed (Autoware's matrix) or laplace (-H^-1 at the optimum, floored at the fixed one)",
+       [](const C& c) { return S(c.ndt.source.ndt.covariance == CovarianceMode::kFixed ? "fixed" : "laplace"); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         c.ndt.source.ndt.covariance = r.choice(n, k, {"fixed", "laplace"}) == "fixed" ? CovarianceMode::kFixed : CovarianceMode::kLaplace; }},
+      {"ndt", "fixed_covariance", "m^2, rad^2", "variances x, y, z, roll, pitch, yaw of the fixed covariance", [](const C& c) { return yamlList(c.ndt.source.ndt.fixed_covariance); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.fixed_covariance = readVariances(r, n, k); }},
+      {"ndt", "min_range", "m", "scan points closer than this are dropped (the vehicle itself)", [](const C& c) { return show(c.ndt.source.preprocess.min_range); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.min_range = r.number(n, k); }},
+      {"ndt", "max_range", "m", "scan points farther than this are dropped", [](const C& c) { return show(c.ndt.source.preprocess.max_range); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.max_range = r.number(n, k); }},
+      {"ndt", "deskew", "", "undo the vehicle's motion during the sweep (needs per-point times)", [](const C& c) { return S(c.ndt.source.preprocess.deskew ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.deskew = r.flag(n, k); }},
+      {"ndt", "voxel_size", "m", "scan downsampling before NDT; 0 = off", [](const C& c) { return show(c.ndt.source.preprocess.voxel_size); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.voxel_size = r.number(n, k); }},
+      {"ndt", "max_points", "", "at most this many scan points reach NDT (a repeatable random subset); 0 = all", [](const C& c) { return show(c.ndt.source.preprocess.max_points); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.max_points = static_cast<std::size_t>(r.integer(n, k, 0, 1LL << 40)); }},
+      {"ndt", "lidar_pose", "m, rad", "the LiDAR on the vehicle: x, y, z, roll, pitch, yaw", [](const C& c) { return yamlList(c.ndt.source.lidar_pose); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         const auto v = r.numbers(n, k, 6, "6 numbers [x, y, z, roll, pitch, yaw]");
+         c.ndt.source.lidar_pose = Eigen::Map<const Vector6d>(v.data()); }},
+      {"ndt", "map_tile_size", "m", "a single-file map is cut into squares of this size", [](const C& c) { return show(c.ndt.map_tile_size); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.map_tile_size = r.positive(n, k); }},
+      {"ndt", "map_radius", "m", "map tiles within this of the vehicle make the NDT target", [](const C& c) { return show(c.ndt.source.map.radius); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.map.radius = r.number(n, k); }},
+      {"ndt", "map_update_distance", "m", "travel before the target is rebuilt around the vehicle", [](const C& c) { return show(c.ndt.source.map.update_distance); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.map.update_distance = r.number(n, k); }},
+      // ---- rsu
+      {"rsu", "registry", "", "RSU registry file (relative to this file); with it, fixes pass the registry's checks; null = none",
+       [](const C& c) { return quoted(c.rsu.registry); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.registry = n.IsNull() ? S() : r.text(n, k); }},
+      {"rsu", "max_age", "s", "fixes older than this when they arrive are refused (stale)", [](const C& c) { return show(c.rsu.checks.max_age); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.checks.max_age = r.inRange(n, k, 0.001, 60.0); }},
+      {"rsu", "future_tolerance", "s", "fixes stamped further than this after their arrival are refused (from_future)",
+       [](const C& c) { return show(c.rsu.checks.future_tolerance); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.checks.future_tolerance = r.inRange(n, k, 0.0, 10.0); }},
+      // ---- pipeline
+      {"pipeline", "initial_pose", "m, rad", "[x, y, z, yaw] to start the filter at the first input (NDT needs a first guess); null = from the first full pose",
+       [](const C& c) { return c.pipeline.initial_pose ? yamlList(*c.pipeline.initial_pose) : S("null"); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         if (n.IsNull()) return c.pipeline.initial_pose.reset();
+         const auto v = r.numbers(n, k, 4, "[x, y, z, yaw]");
+         for (int i = 0; i < 4; ++i)
+           if (!std::isfinite(v[i])) r.fail(n[i], k, "must be finite");
+         c.pipeline.initial_pose = Eigen::Vector4d(v[0], v[1], v[2], v[3]); }},
+      // ---- messages
+      {"messages", "zero_variance_is_unmeasured", "", "read a 0 variance in a message as +inf, as ROS drivers write 0 for what they do not estimate",
+       [](const C& c) { return S(c.messages.zero_variance_is_unmeasured ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.messages.zero_variance_is_unmeasured = r.flag(n, k); }},
+      {"messages", "fallback_pose_variance", "m^2, rad^2", "pose covariance diagonal for messages that carry none (Autoware's NDT value)",
+       [](const C& c) { return yamlList(c.messages.fallback_pose_variance); },
+       [](const R& r, const N& n, const S& k, C& c) { c.messages.fallback_pose_variance = readVariances(r, n, k); }},
+      {"messages", "fallback_twist_variance", "(m/s)^2, (rad/s)^2", "twist covariance diagonal for messages that carry none (Autoware's 0.2 m/s, 0.1 rad/s)",
+       [](const C& c) { return yamlList(c.messages.fallback_twist_variance); },
+       [](const R& r, const N& n, const S& k, C& c) { c.messages.fallback_twist_variance = readVariances(r, n, k); }},
+      // ---- replay
+      {"replay", "clock", "", "auto, same or separate: are header stamps and log times on one clock? auto decides from the data",
+       [](const C& c) { return S(toString(c.replay.clock)); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         const S v = r.choice(n, k, {"auto", "same", "separate"});
+         c.replay.clock = v == "auto" ? ClockMode::kAuto : v == "same" ? ClockMode::kSame : ClockMode::kSeparate; }},
+      {"replay", "ground_truth_max_gap", "s", "ground truth is interpolated to the filter's ticks only across gaps up to this",
+       [](const C& c) { return show(c.replay.ground_truth_max_gap); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         c.replay.ground_truth_max_gap = r.inRange(n, k, 0.0, 10.0);
+         if (c.replay.ground_truth_max_gap == 0.0) r.fail(n, k, "must be > 0"); }},
+      // ---- live
+      {"live", "scan_topic", "", "PointCloud2 scans for NDT", [](const C& c) { return quoted(c.live.scan_topic); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.scan_topic = r.text(n, k); }},
+      {"live", "twist_topic", "", "the vehicle's twist", [](const C& c) { return quoted(c.live.twist_topic); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.twist_topic = r.text(n, k); }},
+      {"live", "twist_type", "", "its type: geometry_msgs/msg/TwistWithCovarianceStamped, nav_msgs/msg/Odometry or sensor_msgs/msg/Imu",
+       [](const C& c) { return quoted(c.live.twist_type); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         c.live.twist_type = r.choice(n, k, {"geometry_msgs/msg/TwistWithCovarianceStamped", "nav_msgs/msg/Odometry", "sensor_msgs/msg/Imu"}); }},
+      {"live", "initial_pose_topic", "", "PoseWithCovarianceStamped that (re)starts the filter, as RViz's 2D Pose Estimate sends it",
+       [](const C& c) { return quoted(c.live.initial_pose_topic); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.initial_pose_topic = r.text(n, k); }},
+      {"live", "pose_topic", "", "the fused pose out (PoseWithCovarianceStamped), every tick", [](const C& c) { return quoted(c.live.pose_topic); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.pose_topic = r.text(n, k); }},
+      {"live", "odometry_topic", "", "the fused pose and twist out (Odometry), every tick", [](const C& c) { return quoted(c.live.odometry_topic); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.odometry_topic = r.text(n, k); }},
+      {"live", "frame_id", "", "frame of the fused pose", [](const C& c) { return quoted(c.live.frame_id); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.frame_id = r.text(n, k); }},
+      {"live", "child_frame_id", "", "the vehicle's frame (Odometry's child frame)", [](const C& c) { return quoted(c.live.child_frame_id); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.child_frame_id = r.text(n, k); }},
+      {"live", "reliable", "", "reliable QoS on the inputs instead of ROS 2 sensor data (best effort)",
+       [](const C& c) { return S(c.live.reliable ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.live.reliable = r.flag(n, k); }},
+  };
+  return table;
+}
+
+const char* kSections[] = {"ndt", "rsu", "pipeline", "messages", "replay", "live"};
+
+const char* sectionComment(const std::string& section) {
+  if (section == "ndt") return "# Scan matching of PointCloud2 scans against the map given with --map.";
+  if (section == "rsu") return "# Roadside fixes: the registry of trusted RSUs and the checks every fix passes (live and offline alike).";
+  if (section == "pipeline") return "# The vehicle pipeline.";
+  if (section == "messages") return "# How messages become measurements.";
+  if (section == "replay") return "# Offline replay of recorded logs (coloc fuse).";
+  return "# The live localizer's topics (coloc localize): ROS 2 names, DDS adds \"rt\".";
+}
+
+void readSection(const YamlReader& r, const std::string& section, const YAML::Node& node, Config& config) {
+  r.requireMap(node, section);
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    const Key* found = nullptr;
+    for (const Key& k : keys())
+      if (section == k.section && key == k.key) found = &k;
+    if (!found) r.fail(entry.first, section + "." + key, "unknown key (see `coloc config`)");
+    found->set(r, entry.second, section + "." + key, config);
+  }
+}
+
+}  // namespace
+
+Config parseConfig(const std::string& yaml_text, const std::string& source_name) {
+  const YamlReader r(source_name);
+  const YAML::Node root = r.parse(yaml_text);
+  Config config;
+  if (root.IsNull()) return config;
+  r.requireMap(root, "(top level)");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    if (key == "fusion") {
+      readFusion(r, entry.second, config.fusion);
+    } else if (key == "inputs") {
+      if (entry.second.IsNull()) continue;
+      r.requireMap(entry.second, "inputs");
+      for (const auto& input : entry.second) {
+        const std::string topic = input.first.as<std::string>();
+        config.inputs[topic] = readInput(r, topic, input.second);
+      }
+    } else if (std::find(std::begin(kSections), std::end(kSections), key) != std::end(kSections)) {
+      if (!entry.second.IsNull()) readSection(r, key, entry.second, config);
+      if (key == "ndt") {
+        try {
+          ndt::validate(config.ndt.source);
+        } catch (const Error& e) {
+          r.fail(entry.second, "ndt", e.what());
+        }
+      }
+    } else {
+      r.fail(entry.first, key, "unknown section (fusion, ndt, rsu, pipeline, messages, inputs, replay, live)");
+    }
+  }
+  std::set<std::string> sources;
+  for (const auto& [topic, input] : config.inputs)
+    if ((input.role == InputRole::kPose || input.role == InputRole::kTwist || input.role == InputRole::kScan) &&
+        !sources.insert(input.source).second)
+      throw Error(source_name + ": inputs." + topic + ".source: '" + input.source + "' is used by two inputs");
+  return config;
+}
+
+Config loadConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the config file");
+  std::stringstream text;
+  text << in.rdbuf();
+  Config config = parseConfig(text.str(), path);
+  namespace fs = std::filesystem;
+  if (!config.rsu.registry.empty() && fs::path(config.rsu.registry).is_relative())
+    config.rsu.registry = (fs::path(path).parent_path() / config.rsu.registry).lexically_normal().string();
+  return config;
+}
+
+std::string defaultConfigYaml() {
+  const Config defaults;
+  std::ostringstream out;
+  out << "# coloc configuration: every key with its default. Any key may be left out.\n"
+         "# Generated by `coloc config`; the README's table documents each key.\n\n"
+         "fusion:\n";
+  for (const auto& p : fusion::ekfParams()) {
+    out << "  # " << p.meaning;
+    if (*p.unit) out << " [" << p.unit << "]";
+    out << "\n  " << p.key << ": " << fusion::formatValue(p, defaults.fusion) << "\n";
+  }
+  for (const char* section : kSections) {
+    out << "\n" << sectionComment(section) << "\n" << section << ":\n";
+    for (const Key& k : keys()) {
+      if (std::string(k.section) != section) continue;
+      out << "  # " << k.meaning;
+      if (*k.unit) out << " [" << k.unit << "]";
+      out << "\n  " << k.key << ": " << k.get(defaults) << "\n";
+    }
+    if (std::string(section) == "messages")
+      out << "\n# How log topics feed the filter. Topics not listed here are chosen by message type:\n"
+             "# PoseWithCovarianceStamped -> pose (rsu_fix on /rsu/<id>/fix when rsu.registry is set);\n"
+             "# TwistWithCovarianceStamped, Odometry, Imu -> twist; PointCloud2 -> scan (with --map);\n"
+             "# Odometry or poses on a topic whose name contains \"ground_truth\" -> ground truth; others are listed and skipped.\n"
+             "# Example:\n"
+             "#   /amcl_pose: {role: pose, source: amcl}\n"
+             "#   /odom: {role: twist, covariance_diagonal: [0.01, .inf, .inf, .inf, .inf, 0.0025]}\n"
+             "#   /rsu/rsu_a/fix: {role: rsu_fix, link: {delay: 0.03, jitter: 0.005, loss: 0.2, seed: 1}}\n"
+             "inputs: {}\n";
+  }
+  return out.str();
+}
+
+std::string configReferenceMarkdown() {
+  const Config defaults;
+  std::ostringstream out;
+  out << "| key | default | unit | meaning |\n|---|---|---|---|\n";
+  for (const auto& p : fusion::ekfParams())
+    out << "| `fusion." << p.key << "` | `" << fusion::formatValue(p, defaults.fusion) << "` | " << p.unit << " | "
+        << p.meaning << " |\n";
+  for (const char* section : kSections) {
+    for (const Key& k : keys())
+      if (std::string(k.section) == section)
+        out << "| `" << k.section << "." << k.key << "` | `" << k.get(defaults) << "` | " << k.unit << " | " << k.meaning << " |\n";
+    if (std::string(section) == "messages")
+      out << "| `inputs.TOPIC.role` | by type | | `pose`, `twist`, `ground_truth`, `scan` (PointCloud2 for NDT), `rsu_fix` (through the registry's checks) or `ignore` |\n"
+             "| `inputs.TOPIC.source` | the topic | | the source's name in the filter and the summary |\n"
+             "| `inputs.TOPIC.covariance_diagonal` | from the message | variances | 6 values replacing the message's covariance; `.inf` = not measured (rsu_fix: the registry's variance) |\n"
+             "| `inputs.TOPIC.additional_delay` | `0` | s | the data was sensed this long before its stamp |\n"
+             "| `inputs.TOPIC.link` | none | | replay the topic through an emulated link: `{delay, jitter, loss, burst, p_good_to_bad, "
+             "p_bad_to_good, loss_in_good, loss_in_bad, seed}` (s, probabilities); deterministic |\n";
+  }
+  return out.str();
+}
+
+}  // namespace coloc::pipeline

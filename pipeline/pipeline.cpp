@@ -1,0 +1,395 @@
+#include "coloc/pipeline/pipeline.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <thread>
+#include <variant>
+
+#include "coloc/core/error.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
+#include "inbox.hpp"
+
+namespace coloc::pipeline {
+
+namespace {
+
+struct ScanInput {
+  ndt::PointCloud cloud;
+  Stamp stamp;
+};
+struct TwistInput {
+  fusion::SourceId source;
+  TwistMeasurement twist;
+};
+struct PoseInput {
+  fusion::SourceId source;
+  PoseMeasurement pose;
+};
+struct FixInput {
+  rsu_client::RsuFix fix;
+};
+struct InitialPoseInput {
+  PoseMeasurement pose;
+};
+/// NDT's result for a scan, back from the NDT thread.
+struct NdtResult {
+  ndt::ScanOutcome outcome;
+  Stamp scan_stamp;
+};
+using Input = std::variant<ScanInput, TwistInput, PoseInput, FixInput, InitialPoseInput, NdtResult>;
+
+Stamp stampOf(const Input& input) {
+  return std::visit(
+      [](const auto& i) -> Stamp {
+        using T = std::decay_t<decltype(i)>;
+        if constexpr (std::is_same_v<T, ScanInput>) return i.stamp;
+        else if constexpr (std::is_same_v<T, TwistInput>) return i.twist.stamp;
+        else if constexpr (std::is_same_v<T, FixInput>) return i.fix.stamp;
+        else if constexpr (std::is_same_v<T, NdtResult>) return i.scan_stamp;
+        else return i.pose.stamp;
+      },
+      input);
+}
+
+PoseMeasurement initialPose(const Eigen::Vector4d& xyz_yaw, Stamp stamp) {
+  PoseMeasurement m;
+  m.stamp = stamp;
+  m.pose.position = xyz_yaw.head<3>();
+  m.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, xyz_yaw[3]);
+  m.covariance = Matrix6d::Zero();
+  m.covariance.diagonal() << 1.0, 1.0, 1.0, kInfinity, kInfinity, 0.01;  // a rough start, as a hand-placed pose
+  return m;
+}
+
+constexpr std::size_t kKeptRejections = 20;
+
+}  // namespace
+
+// NDT on a thread of its own (live): one scan matched at a time; a newer scan replaces the one waiting.
+class NdtThread {
+ public:
+  using Done = std::function<void(ndt::ScanOutcome, Stamp scan_stamp)>;
+  NdtThread(ndt::NdtPoseSource& source, Done done) : source_(source), done_(std::move(done)), thread_([this] { run(); }) {}
+  ~NdtThread() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  /// False if a waiting scan was replaced.
+  bool submit(ndt::PointCloud cloud, Stamp stamp, const fusion::Estimate& guess) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool replaced = job_.has_value();
+    job_ = Job{std::move(cloud), stamp, guess};
+    wake_.notify_all();
+    return !replaced;
+  }
+  ndt::NdtPoseSourceCounters counters() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return counters_;
+  }
+  ndt::DynamicMapStats mapStats() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return map_stats_;
+  }
+
+ private:
+  struct Job {
+    ndt::PointCloud cloud;
+    Stamp stamp;
+    fusion::Estimate guess;
+  };
+  void run() {
+    for (;;) {
+      Job job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || job_.has_value(); });
+        if (stop_) return;
+        job = std::move(*job_);
+        job_.reset();
+      }
+      ndt::ScanOutcome outcome = source_.process(job.cloud, job.stamp, job.guess.pose, job.guess.state[4], job.guess.state[5]);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        counters_ = source_.counters();
+        map_stats_ = source_.map().stats();
+      }
+      done_(std::move(outcome), job.stamp);
+    }
+  }
+  ndt::NdtPoseSource& source_;
+  Done done_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<Job> job_;
+  bool stop_ = false;
+  ndt::NdtPoseSourceCounters counters_;
+  ndt::DynamicMapStats map_stats_;
+  std::thread thread_;  // last: starts once everything above exists
+};
+
+struct Pipeline::Impl {
+  Config config;
+  Duration step;
+  std::function<Stamp()> now;
+  Inbox<Input> inbox;
+
+  mutable std::mutex state_mutex;  // the filter and everything below; held while draining
+  fusion::Localizer localizer;
+  std::vector<std::string> source_names;  // by SourceId
+  std::unique_ptr<ndt::NdtPoseSource> ndt;
+  fusion::SourceId ndt_id = -1;
+  std::optional<rsu_client::FixChecker> checker;
+  std::map<std::string, fusion::SourceId> fix_sources;  // by RSU id
+  bool first_input_seen = false;
+  Stamp clock = 0;
+  bool clock_set = false;
+  PipelineReport report;
+  std::function<void(const fusion::Estimate&)> on_estimate;
+  std::function<void(const std::string&, const PoseMeasurement&)> on_pose_input;
+  std::function<void(const std::string&)> on_rejection;
+
+  mutable std::mutex estimate_mutex;
+  std::optional<fusion::Estimate> latest;
+
+  std::unique_ptr<NdtThread> ndt_thread;  // declared after what it uses, so it stops first
+  std::thread loop;
+  std::mutex loop_mutex;
+  std::condition_variable loop_wake;
+  bool loop_stop = false;
+
+  Impl(const Config& c, PipelineOptions& options)
+      : config(c),
+        step(static_cast<Duration>(std::llround(1e9 / c.fusion.predict_frequency))),
+        now(options.clock ? options.clock : std::function<Stamp()>(rsu_client::systemNow)),
+        localizer(c.fusion) {
+    localizer.setVerdictListener([this](const fusion::Verdict& v) {
+      if (v.rejected()) reject(v.message());
+    });
+    if (options.map) {
+      ndt::NdtPoseSourceConfig ndt_config = config.ndt.source;
+      // Offline the target is built inline: the same log then gives the same bytes, whatever the machine's speed.
+      if (!options.ndt_thread) ndt_config.map.background = false;
+      ndt = std::make_unique<ndt::NdtPoseSource>(std::move(*options.map), ndt_config);
+      ndt_id = addSource(kNdtSource, fusion::SourceKind::kPose);
+      report.ndt_used = true;
+      if (options.ndt_thread)
+        ndt_thread = std::make_unique<NdtThread>(*ndt, [this](ndt::ScanOutcome outcome, Stamp stamp) {
+          inbox.push(NdtResult{std::move(outcome), stamp}, now());
+        });
+    }
+    if (options.registry) {
+      checker.emplace(std::move(*options.registry), config.rsu.checks);
+      for (const rsu_client::RsuInfo& rsu : checker->registry().rsus())
+        fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose);
+    }
+  }
+
+  fusion::SourceId addSource(const std::string& name, fusion::SourceKind kind) {
+    const fusion::SourceId id = kind == fusion::SourceKind::kPose ? localizer.addPoseSource(name) : localizer.addTwistSource(name);
+    if (static_cast<std::size_t>(id) >= source_names.size()) source_names.resize(id + 1);
+    source_names[id] = name;
+    return id;
+  }
+
+  void reject(const std::string& line) {
+    ++report.rejections;
+    if (report.first_rejections.size() < kKeptRejections) report.first_rejections.push_back(line);
+    if (on_rejection) on_rejection(line);
+  }
+
+  void emit(const fusion::Estimate& e) {
+    ++report.ticks;
+    {
+      std::lock_guard<std::mutex> lock(estimate_mutex);
+      latest = e;
+    }
+    if (on_estimate) on_estimate(e);
+  }
+
+  // Runs the filter's ticks up to `now`, giving out each tick's estimate.
+  void runTo(Stamp now) {
+    if (clock_set && now < clock) now = clock;  // live: an input taken late arrived before the last drain
+    if (localizer.initialized()) {
+      const Stamp latest_tick = localizer.estimate()->stamp;
+      if ((now - latest_tick) / step < 1'000'000) {
+        for (Stamp tick = latest_tick + step; tick <= now; tick += step) {
+          localizer.advanceTo(tick);
+          emit(*localizer.estimate());
+        }
+      }
+    }
+    localizer.advanceTo(now);
+    clock = now;
+    clock_set = true;
+  }
+
+  void feedPose(fusion::SourceId source, const PoseMeasurement& pose) {
+    if (on_pose_input) on_pose_input(source_names[source], pose);
+    const bool was_initialized = localizer.initialized();
+    localizer.feedPose(source, pose);
+    if (!was_initialized && localizer.initialized()) emit(*localizer.estimate());
+  }
+
+  void handle(const ndt::ScanOutcome& outcome, Stamp scan_stamp) {
+    if (outcome.produced) feedPose(ndt_id, outcome.pose);
+    else reject("scan stamped " + formatSeconds(scan_stamp) + ": " + outcome.detail);
+  }
+
+  void apply(Input& input, Stamp arrival) {
+    if (auto* scan = std::get_if<ScanInput>(&input)) {
+      if (!ndt) {
+        ++report.scans_without_map;
+        return reject("scan stamped " + formatSeconds(scan->stamp) + ": no map to match it against");
+      }
+      // NDT starts from the filter's prediction for the scan's stamp; its pose goes back in stamped
+      // with the scan, and the filter compensates the matching time as any delay.
+      const std::optional<fusion::Estimate> guess = localizer.estimateAt(scan->stamp);
+      if (!guess) {
+        ++report.scans_without_guess;
+        return;
+      }
+      if (ndt_thread) {
+        if (!ndt_thread->submit(std::move(scan->cloud), scan->stamp, *guess)) ++report.scans_superseded;
+        return;
+      }
+      handle(ndt->process(scan->cloud, scan->stamp, guess->pose, guess->state[4], guess->state[5]), scan->stamp);
+    } else if (auto* result = std::get_if<NdtResult>(&input)) {
+      handle(result->outcome, result->scan_stamp);
+    } else if (auto* twist = std::get_if<TwistInput>(&input)) {
+      localizer.feedTwist(twist->source, twist->twist);
+    } else if (auto* pose = std::get_if<PoseInput>(&input)) {
+      feedPose(pose->source, pose->pose);
+    } else if (auto* fix = std::get_if<FixInput>(&input)) {
+      if (!checker) {
+        report.fixes[fix->fix.rsu_id].received++;
+        report.fixes[fix->fix.rsu_id].unknown_rsu++;
+        return reject("fix from '" + fix->fix.rsu_id + "' stamped " + formatSeconds(fix->fix.stamp) +
+                      " rejected (unknown_rsu): no RSU registry is configured");
+      }
+      const rsu_client::FixVerdict v = checker->check(fix->fix, arrival);
+      if (!v.accepted()) return reject(v.detail);
+      feedPose(fix_sources.at(fix->fix.rsu_id), v.measurement);
+    } else {
+      localizer.initialize(std::get<InitialPoseInput>(input).pose);
+      if (localizer.initialized()) emit(*localizer.estimate());
+    }
+  }
+
+  void drain(Stamp now) {
+    std::lock_guard<std::mutex> lock(state_mutex);
+    while (auto item = inbox.takeArrivedBy(now)) {
+      auto& [arrival, input] = *item;
+      if (!first_input_seen) {
+        first_input_seen = true;
+        if (config.pipeline.initial_pose && !localizer.initialized())
+          localizer.initialize(initialPose(*config.pipeline.initial_pose, stampOf(input)));
+      }
+      runTo(arrival);
+      apply(input, arrival);
+    }
+    runTo(now);
+  }
+
+  void liveLoop() {
+    std::unique_lock<std::mutex> lock(loop_mutex);
+    while (!loop_stop) {
+      lock.unlock();
+      drain(now());
+      lock.lock();
+      loop_wake.wait_for(lock, std::chrono::nanoseconds(step), [&] { return loop_stop; });
+    }
+  }
+};
+
+Pipeline::Pipeline(const Config& config, PipelineOptions options) : impl_(std::make_unique<Impl>(config, options)) {}
+
+Pipeline::~Pipeline() { stop(); }
+
+fusion::SourceId Pipeline::addPoseSource(const std::string& name) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  return impl_->addSource(name, fusion::SourceKind::kPose);
+}
+
+fusion::SourceId Pipeline::addTwistSource(const std::string& name) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  return impl_->addSource(name, fusion::SourceKind::kTwist);
+}
+
+std::optional<fusion::SourceId> Pipeline::fixSource(const std::string& rsu_id) const {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  const auto found = impl_->fix_sources.find(rsu_id);
+  if (found == impl_->fix_sources.end()) return std::nullopt;
+  return found->second;
+}
+
+void Pipeline::pushScan(ndt::PointCloud scan, Stamp stamp, Stamp arrival) { impl_->inbox.push(ScanInput{std::move(scan), stamp}, arrival); }
+void Pipeline::pushTwist(fusion::SourceId source, const TwistMeasurement& twist, Stamp arrival) {
+  impl_->inbox.push(TwistInput{source, twist}, arrival);
+}
+void Pipeline::pushPose(fusion::SourceId source, const PoseMeasurement& pose, Stamp arrival) {
+  impl_->inbox.push(PoseInput{source, pose}, arrival);
+}
+void Pipeline::pushFix(const rsu_client::RsuFix& fix, Stamp arrival) { impl_->inbox.push(FixInput{fix}, arrival); }
+void Pipeline::pushInitialPose(const PoseMeasurement& pose, Stamp arrival) { impl_->inbox.push(InitialPoseInput{pose}, arrival); }
+
+void Pipeline::onEstimate(std::function<void(const fusion::Estimate&)> callback) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  impl_->on_estimate = std::move(callback);
+}
+void Pipeline::onPoseInput(std::function<void(const std::string&, const PoseMeasurement&)> callback) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  impl_->on_pose_input = std::move(callback);
+}
+void Pipeline::onRejection(std::function<void(const std::string&)> callback) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  impl_->on_rejection = std::move(callback);
+}
+
+void Pipeline::runUntil(Stamp now) { impl_->drain(now); }
+
+void Pipeline::start() {
+  if (impl_->loop.joinable()) return;
+  impl_->loop_stop = false;
+  impl_->loop = std::thread([this] { impl_->liveLoop(); });
+}
+
+void Pipeline::stop() {
+  if (!impl_->loop.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(impl_->loop_mutex);
+    impl_->loop_stop = true;
+  }
+  impl_->loop_wake.notify_all();
+  impl_->loop.join();
+  impl_->drain(impl_->now());  // what arrived before the stop still counts
+}
+
+PipelineReport Pipeline::report() const {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  PipelineReport r = impl_->report;
+  r.sources = impl_->localizer.sources();
+  r.unknown_source_inputs = impl_->localizer.unknownSourceCount();
+  if (impl_->ndt_thread) {
+    r.ndt = impl_->ndt_thread->counters();
+    r.map = impl_->ndt_thread->mapStats();
+  } else if (impl_->ndt) {
+    r.ndt = impl_->ndt->counters();
+    r.map = impl_->ndt->map().stats();
+  }
+  if (impl_->checker)
+    for (const auto& [id, c] : impl_->checker->counters()) r.fixes[id] = c;
+  return r;
+}
+
+std::optional<fusion::Estimate> Pipeline::estimate() const {
+  std::lock_guard<std::mutex> lock(impl_->estimate_mutex);
+  return impl_->latest;
+}
+
+}  // namespace coloc::pipeline

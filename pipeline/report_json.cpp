@@ -1,0 +1,43 @@
+#include "coloc/pipeline/report_json.hpp"
+
+#include <nlohmann/json.hpp>
+
+namespace coloc::pipeline {
+
+std::string sourcesJson(const std::vector<fusion::SourceReport>& sources) {
+  auto list = nlohmann::ordered_json::array();
+  for (const auto& s : sources) {
+    const fusion::SourceCounters& c = s.counters;
+    const nlohmann::ordered_json counters = {
+        {"received", c.received},   {"applied", c.applied},         {"gated", c.gated},
+        {"too_old", c.too_old},     {"from_future", c.from_future}, {"invalid", c.invalid},
+        {"not_initialized", c.not_initialized}, {"numerical", c.numerical}, {"pending", c.pending},
+        {"smoothing_shortened", c.smoothing_shortened}, {"gate_recovered", c.gate_recovered}};
+    list.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"}, {"counters", counters}});
+  }
+  return list.dump();
+}
+
+std::string ndtJson(const ndt::NdtPoseSourceCounters& n, const ndt::DynamicMapStats& map, std::uint64_t scans_without_guess) {
+  const nlohmann::ordered_json j = {{"scans", n.scans},
+                                    {"poses", n.poses},
+                                    {"scans_without_guess", scans_without_guess},
+                                    {"no_map", n.no_map},
+                                    {"empty_scan", n.empty_scan},
+                                    {"max_iterations", n.max_iterations},
+                                    {"oscillation", n.oscillation},
+                                    {"low_score", n.low_score},
+                                    {"map_builds", map.builds},
+                                    {"tiles_in_target", map.tiles_in_target}};
+  return j.dump();
+}
+
+std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (const auto& [id, c] : fixes)
+    j[id] = {{"received", c.received},       {"accepted", c.accepted}, {"unknown_rsu", c.unknown_rsu}, {"non_finite", c.non_finite},
+             {"out_of_coverage", c.out_of_coverage}, {"stale", c.stale}, {"from_future", c.from_future}, {"duplicate", c.duplicate}};
+  return j.dump();
+}
+
+}  // namespace coloc::pipeline

@@ -1,0 +1,229 @@
+#include "coloc/replay/log_replay.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <type_traits>
+#include <variant>
+
+#include "coloc/core/error.hpp"
+#include "coloc/io/bag_reader.hpp"
+#include "coloc/io/ros_messages.hpp"
+#include "coloc/pipeline/message_inputs.hpp"
+#include "coloc/rsu_client/link_emulator.hpp"
+
+namespace coloc::replay {
+
+namespace {
+
+using pipeline::InputConfig;
+
+// A decoded input waiting to be replayed.
+struct Event {
+  Stamp log_time;
+  Stamp stamp;
+  Stamp arrival;  ///< log_time on the stamp clock
+  std::uint64_t order;
+  std::size_t topic;
+  std::variant<PoseMeasurement, TwistMeasurement, ndt::PointCloud, rsu_client::RsuFix> input;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Stage 2: every message of a used topic, decoded; ground truth goes straight into the result.
+std::vector<Event> decodeAll(io::BagReader& bag, const pipeline::Config& config, ReplayResult& result,
+                             const std::function<void(double)>& progress) {
+  std::map<std::string, std::size_t> topic_index;
+  for (std::size_t i = 0; i < result.topics.size(); ++i) topic_index[result.topics[i].topic] = i;
+  std::vector<Event> events;
+  const std::uint64_t total = std::max<std::uint64_t>(bag.messageCount(), 1);
+  io::BagMessage message;
+  Stamp first_log = 0, last_log = 0;
+  while (bag.next(message)) {
+    if (result.messages_read == 0) first_log = message.log_time;
+    last_log = message.log_time;
+    if (progress && result.messages_read % 256 == 0) progress(0.5 * result.messages_read / total);
+    ++result.messages_read;
+    const auto found = topic_index.find(message.topic);
+    if (found == topic_index.end()) continue;
+    const std::size_t ti = found->second;
+    TopicUse& use = result.topics[ti];
+    ++use.messages;
+    if (use.role == InputRole::kIgnore) continue;
+    const InputConfig* input = use.from_config ? &config.inputs.at(use.topic) : nullptr;
+    try {
+      const io::RosMessage decoded = io::decodeMessage(*use.kind, message.data);
+      bool fallback = false;
+      Event e{message.log_time, 0, 0, message.index, ti, PoseMeasurement{}};
+      switch (use.role) {
+        case InputRole::kScan: {
+          const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
+          e.stamp = cloud.header.stamp;
+          e.input = pipeline::toPointCloud(cloud);
+          events.push_back(std::move(e));
+          continue;
+        }
+        case InputRole::kGroundTruth: {
+          const PoseMeasurement p = pipeline::poseFromMessage(decoded, input, config.messages, fallback);
+          result.ground_truth.push_back({p.stamp, p.pose});
+          continue;
+        }
+        case InputRole::kRsuFix:
+          e.input = pipeline::fixFromMessage(std::get<io::StampedPose>(decoded), use.rsu_id);
+          break;
+        case InputRole::kTwist:
+          e.input = pipeline::twistFromMessage(decoded, input, config.messages, fallback);
+          break;
+        default:
+          e.input = pipeline::poseFromMessage(decoded, input, config.messages, fallback);
+          break;
+      }
+      if (fallback) ++use.fallback_covariance;
+      // The measurement's own stamp, moved back by the configured sensing delay.
+      std::visit(
+          [&](auto& m) {
+            if constexpr (!std::is_same_v<std::decay_t<decltype(m)>, ndt::PointCloud>) {
+              if (input && input->additional_delay > 0.0) m.stamp -= fromSeconds(input->additional_delay);
+              e.stamp = m.stamp;
+            }
+          },
+          e.input);
+      events.push_back(std::move(e));
+    } catch (const Error& err) {
+      if (use.decode_errors++ == 0)
+        use.first_error = "topic " + use.topic + " message #" + std::to_string(message.index) + ": " + err.what();
+    }
+  }
+  result.log_duration = toSeconds(last_log - first_log);
+  return events;
+}
+
+// Stage 3: arrival times on the stamp clock, fitted when the log recorded them on another clock.
+void placeOnStampClock(std::vector<Event>& events, const pipeline::Config& config, ReplayResult& result) {
+  Duration min_offset = std::numeric_limits<Duration>::max();
+  for (const Event& e : events) min_offset = std::min(min_offset, e.log_time - e.stamp);
+  const Duration tolerance = fromSeconds(config.fusion.future_tolerance);
+  result.clock = config.replay.clock;
+  if (result.clock == ClockMode::kAuto)
+    result.clock = events.empty() || (min_offset >= -tolerance && min_offset <= 10 * kNanosPerSecond) ? ClockMode::kSame
+                                                                                                       : ClockMode::kSeparate;
+  if (result.clock == ClockMode::kSeparate && !events.empty()) {
+    std::vector<ClockSample> samples;
+    samples.reserve(events.size());
+    for (const Event& e : events) samples.push_back({e.log_time, e.stamp});
+    result.clock_fit = fitClock(samples);
+  }
+  for (Event& e : events)
+    e.arrival = result.clock == ClockMode::kSeparate ? std::max(result.clock_fit.toStampClock(e.log_time), e.stamp) : e.log_time;
+}
+
+// Stage 4: topics replayed through an emulated link; each message, in recorded order, is delayed or lost.
+void emulateLinks(std::vector<Event>& events, const pipeline::Config& config, ReplayResult& result) {
+  std::map<std::size_t, rsu_client::LinkEmulator> links;
+  for (std::size_t i = 0; i < result.topics.size(); ++i)
+    if (result.topics[i].from_config && config.inputs.at(result.topics[i].topic).link)
+      links.emplace(i, rsu_client::LinkEmulator(*config.inputs.at(result.topics[i].topic).link));
+  if (links.empty()) return;
+  std::vector<Event> kept;
+  kept.reserve(events.size());
+  for (Event& e : events) {
+    const auto link = links.find(e.topic);
+    if (link != links.end()) {
+      const std::optional<Stamp> delivered = link->second.transmit(e.arrival);
+      if (!delivered) {
+        ++result.topics[e.topic].link_dropped;
+        continue;
+      }
+      e.arrival = *delivered;
+    }
+    kept.push_back(std::move(e));
+  }
+  events = std::move(kept);
+}
+
+void measureDelays(const std::vector<Event>& events, ReplayResult& result) {
+  std::vector<std::vector<double>> delays(result.topics.size());
+  for (const Event& e : events) delays[e.topic].push_back(toSeconds(e.arrival - e.stamp));
+  for (std::size_t i = 0; i < delays.size(); ++i) {
+    if (delays[i].empty()) continue;
+    result.topics[i].delay_median = median(delays[i]);
+    result.topics[i].delay_max = *std::max_element(delays[i].begin(), delays[i].end());
+  }
+}
+
+// Stage 5: the inputs through the vehicle pipeline in arrival order, its clock driven by log time.
+void drive(std::vector<Event>& events, const ReplayOptions& options, std::optional<rsu_client::RsuRegistry> registry,
+           ReplayResult& result) {
+  pipeline::PipelineOptions po;
+  po.registry = std::move(registry);
+  bool scans = false;
+  for (const TopicUse& t : result.topics) scans = scans || t.role == InputRole::kScan;
+  if (scans && !options.map.empty()) po.map = ndt::TileMap::open(options.map, options.config.ndt.map_tile_size);
+  pipeline::Pipeline pipe(options.config, std::move(po));
+  std::vector<fusion::SourceId> source_of(result.topics.size(), -1);
+  for (std::size_t i = 0; i < result.topics.size(); ++i) {
+    if (result.topics[i].role == InputRole::kPose) source_of[i] = pipe.addPoseSource(result.topics[i].source);
+    if (result.topics[i].role == InputRole::kTwist) source_of[i] = pipe.addTwistSource(result.topics[i].source);
+  }
+  pipe.onEstimate([&](const fusion::Estimate& e) { result.fused.push_back({e.stamp, e.pose}); });
+  pipe.onPoseInput([&](const std::string&, const PoseMeasurement& p) { result.pose_inputs.push_back({p.stamp, p.pose}); });
+  pipe.onRejection([&](const std::string& line) {
+    if (result.rejections.size() < 20) result.rejections.push_back(line);
+  });
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    Event& e = events[i];
+    if (options.progress && (i % 256 == 0 || std::holds_alternative<ndt::PointCloud>(e.input)))
+      options.progress(0.5 + 0.5 * i / events.size());
+    if (auto* scan = std::get_if<ndt::PointCloud>(&e.input)) pipe.pushScan(std::move(*scan), e.stamp, e.arrival);
+    else if (auto* fix = std::get_if<rsu_client::RsuFix>(&e.input)) pipe.pushFix(*fix, e.arrival);
+    else if (auto* twist = std::get_if<TwistMeasurement>(&e.input)) pipe.pushTwist(source_of[e.topic], *twist, e.arrival);
+    else pipe.pushPose(source_of[e.topic], std::get<PoseMeasurement>(e.input), e.arrival);
+    pipe.runUntil(e.arrival);
+  }
+  if (options.progress) options.progress(1.0);
+  const pipeline::PipelineReport report = pipe.report();
+  result.sources = report.sources;
+  result.unknown_source_inputs = report.unknown_source_inputs;
+  result.ndt_used = report.ndt_used;
+  result.ndt = report.ndt;
+  result.map = report.map;
+  result.scans_without_guess = report.scans_without_guess;
+  result.fixes = report.fixes;
+}
+
+}  // namespace
+
+ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const pipeline::Config& config = options.config;
+  std::optional<rsu_client::RsuRegistry> registry = options.registry;
+  if (!registry && !config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(config.rsu.registry);
+  io::BagReader bag = io::BagReader::open(log_path);
+  ReplayResult result;
+  result.topics = planTopics(bag.topics(), config, !options.map.empty(), registry ? &*registry : nullptr, result.rejections);
+  std::vector<Event> events = decodeAll(bag, config, result, options.progress);
+  placeOnStampClock(events, config, result);
+  emulateLinks(events, config, result);
+  measureDelays(events, result);
+  std::sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+    return a.arrival != b.arrival ? a.arrival < b.arrival : a.order < b.order;
+  });
+  drive(events, options, std::move(registry), result);
+  if (!result.fused.empty()) {
+    result.first_stamp = result.fused.front().stamp;
+    result.last_stamp = result.fused.back().stamp;
+  }
+  std::sort(result.ground_truth.begin(), result.ground_truth.end(),
+            [](const io::TrajectoryPoint& a, const io::TrajectoryPoint& b) { return a.stamp < b.stamp; });
+  result.errors = evaluate(result.fused, result.ground_truth, fromSeconds(config.replay.ground_truth_max_gap));
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return result;
+}
+
+}  // namespace coloc::replay

@@ -1,0 +1,65 @@
+// summary.json and error.csv of a replay: everything in them follows from the log and the config, so
+// that reruns give the same bytes; run times are reported apart (timing.json).
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "coloc/core/error.hpp"
+#include "coloc/replay/log_replay.hpp"
+#include "coloc/pipeline/report_json.hpp"
+
+namespace coloc::replay {
+
+std::string ReplayResult::summaryJson(const std::string& log) const {
+  nlohmann::ordered_json j;
+  j["log"] = log;
+  j["messages"] = messages_read;
+  j["log_duration_s"] = log_duration;
+  j["clock"] = {{"mode", clock == ClockMode::kSeparate ? "separate" : "same"}};
+  if (clock == ClockMode::kSeparate) {
+    j["clock"]["rate"] = clock_fit.rate;
+    j["clock"]["log_origin"] = formatSeconds(clock_fit.log_origin);
+    j["clock"]["stamp_origin"] = formatSeconds(clock_fit.stamp_origin);
+  }
+  auto& topic_list = j["topics"] = nlohmann::ordered_json::array();
+  for (const TopicUse& t : topics) {
+    nlohmann::ordered_json o = {{"topic", t.topic}, {"type", t.type}, {"role", toString(t.role)}, {"messages", t.messages}};
+    if (t.role == InputRole::kPose || t.role == InputRole::kTwist || t.role == InputRole::kRsuFix) o["source"] = t.source;
+    if (t.role != InputRole::kIgnore) {
+      o["decode_errors"] = t.decode_errors;
+      o["fallback_covariance"] = t.fallback_covariance;
+      o["link_dropped"] = t.link_dropped;
+      o["delay_median_s"] = t.delay_median;
+      o["delay_max_s"] = t.delay_max;
+    }
+    if (!t.first_error.empty()) o["first_error"] = t.first_error;
+    if (!t.note.empty()) o["note"] = t.note;
+    topic_list.push_back(o);
+  }
+  j["sources"] = nlohmann::ordered_json::parse(pipeline::sourcesJson(sources));
+  j["fused"] = {{"file", "fused.tum"}, {"poses", fused.size()}, {"first_stamp", formatSeconds(first_stamp)}, {"last_stamp", formatSeconds(last_stamp)}};
+  if (!errors.empty()) {
+    const ErrorStats s = errorStats();
+    j["position_error"] = {{"samples", errors.size()}, {"mean_m", s.mean}, {"rmse_m", s.rmse}, {"max_m", s.max}, {"file", "error.csv"}};
+  } else {
+    j["position_error"] = nullptr;
+  }
+  if (ndt_used) j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(ndt, map, scans_without_guess));
+  if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes));
+  j["rejections_first"] = rejections;
+  return j.dump(2) + "\n";
+}
+
+void ReplayResult::writeErrorCsv(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot write");
+  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m\n";
+  char line[256];
+  for (const ErrorSample& s : errors) {
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(), s.estimate.y(),
+                  s.truth.x(), s.truth.y(), s.error);
+    out << line;
+  }
+}
+
+}  // namespace coloc::replay

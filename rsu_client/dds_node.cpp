@@ -1,0 +1,178 @@
+#include "coloc/rsu_client/dds_node.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fastdds/dds/topic/TopicDataType.hpp>
+
+#include <atomic>
+#include <cstring>
+#include <map>
+#include <mutex>
+
+#include "coloc/core/error.hpp"
+#include "dds_participant.hpp"
+
+namespace coloc::rsu_client {
+
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::rtps::SerializedPayload_t;
+
+std::string ddsTypeName(const std::string& ros_type) {
+  // pkg/msg/Name -> pkg::msg::dds_::Name_
+  const auto last = ros_type.rfind('/');
+  if (last == std::string::npos) return ros_type;
+  std::string prefix = ros_type.substr(0, last);
+  std::string out;
+  for (char c : prefix) out += c == '/' ? std::string("::") : std::string(1, c);
+  return out + "::dds_::" + ros_type.substr(last + 1) + "_";
+}
+
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+// A type that is its own serialization: the sample is the CDR bytes, encapsulation header included.
+// DDS matches endpoints by type name, so this writer and reader pair with ROS 2's of the same type.
+class SerializedType : public dds::TopicDataType {
+ public:
+  explicit SerializedType(const std::string& name) {
+    setName(name.c_str());
+    m_typeSize = 64 * 1024;  // a first allocation; larger samples grow the payload
+    m_isGetKeyDefined = false;
+  }
+  bool serialize(void* data, SerializedPayload_t* payload) override {
+    const Bytes& bytes = *static_cast<const Bytes*>(data);
+    if (bytes.size() < 4 || payload->max_size < bytes.size()) return false;
+    std::memcpy(payload->data, bytes.data(), bytes.size());
+    payload->length = static_cast<std::uint32_t>(bytes.size());
+    payload->encapsulation = (bytes[1] & 1) ? CDR_LE : CDR_BE;
+    return true;
+  }
+  bool deserialize(SerializedPayload_t* payload, void* data) override {
+    Bytes& bytes = *static_cast<Bytes*>(data);
+    bytes.assign(payload->data, payload->data + payload->length);
+    return true;
+  }
+  std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
+    return [data] { return static_cast<std::uint32_t>(static_cast<const Bytes*>(data)->size()); };
+  }
+  void* createData() override { return new Bytes(); }
+  void deleteData(void* data) override { delete static_cast<Bytes*>(data); }
+  bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) override { return false; }
+};
+
+template <typename Qos>
+Qos applied(Qos q, const TopicQos& t) {
+  q.reliability().kind = t.reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
+  q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = t.depth;
+  q.durability().kind = t.transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  return q;
+}
+
+class WriterMatches : public dds::DataWriterListener {
+ public:
+  void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override { matched = status.current_count; }
+  std::atomic<int> matched{0};
+};
+
+}  // namespace
+
+struct DdsNode::Writer::Impl {
+  dds::DataWriter* writer = nullptr;
+  WriterMatches listener;
+  std::mutex mutex;  // DataWriter::write is thread-safe; the staging copy is not
+  Bytes staging;
+};
+
+bool DdsNode::Writer::write(const std::uint8_t* data, std::size_t size) {
+  if (!impl_ || !impl_->writer) return false;
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->staging.assign(data, data + size);
+  return impl_->writer->write(&impl_->staging);
+}
+
+int DdsNode::Writer::matchedReaders() const { return impl_ ? impl_->listener.matched.load() : 0; }
+
+struct DdsNode::Impl : public dds::DataReaderListener {
+  std::map<std::string, dds::TypeSupport> types;  // by DDS type name
+  std::map<dds::DataReader*, Callback> callbacks;
+  std::vector<std::shared_ptr<Writer::Impl>> writers;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  std::atomic<int> matched{0};
+  std::mutex mutex;  // setup against the listener
+
+  dds::Topic* topic(const std::string& ros_topic, const std::string& ros_type) {
+    const std::string type_name = ddsTypeName(ros_type);
+    auto found = types.find(type_name);
+    if (found == types.end()) found = types.emplace(type_name, dds::TypeSupport(new SerializedType(type_name))).first;
+    dds::Topic* t = topicFor(participant, ros_topic, found->second);
+    if (t->get_type_name() != type_name)
+      throw Error("DDS: topic " + ddsTopicName(ros_topic) + " is already used with type " + t->get_type_name());
+    return t;
+  }
+
+  void on_data_available(dds::DataReader* reader) override {
+    Callback* callback = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      const auto found = callbacks.find(reader);
+      if (found != callbacks.end()) callback = &found->second;
+    }
+    Bytes bytes;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&bytes, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || !callback) continue;
+      (*callback)(std::move(bytes), systemNow());
+      bytes = Bytes();
+    }
+  }
+  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
+    matched += status.current_count_change;
+  }
+  OwnedParticipant participant;  // last member: deleted first, while listeners still exist
+};
+
+DdsNode::DdsNode(const DdsConfig& config) : impl_(std::make_unique<Impl>()) {
+  impl_->participant = createParticipant(config);
+  impl_->publisher = impl_->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  impl_->subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (!impl_->publisher || !impl_->subscriber) throw Error("DDS: cannot create a publisher and a subscriber");
+}
+
+DdsNode::~DdsNode() = default;
+
+DdsNode::Writer DdsNode::advertise(const std::string& ros_topic, const std::string& ros_type, const TopicQos& qos) {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  auto w = std::make_shared<Writer::Impl>();
+  w->writer = impl_->publisher->create_datawriter(impl_->topic(ros_topic, ros_type), applied(dds::DATAWRITER_QOS_DEFAULT, qos), &w->listener);
+  if (!w->writer) throw Error("DDS: cannot publish on " + ddsTopicName(ros_topic) + " (not permitted?)");
+  impl_->writers.push_back(w);
+  Writer writer;
+  writer.impl_ = w;
+  return writer;
+}
+
+void DdsNode::subscribe(const std::string& ros_topic, const std::string& ros_type, const TopicQos& qos, Callback callback) {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  dds::Topic* topic = impl_->topic(ros_topic, ros_type);
+  // Created without a listener, registered, then given one: no sample can reach an unknown reader.
+  dds::DataReader* reader = impl_->subscriber->create_datareader(topic, applied(dds::DATAREADER_QOS_DEFAULT, qos), nullptr);
+  if (!reader) throw Error("DDS: cannot subscribe to " + ddsTopicName(ros_topic));
+  impl_->callbacks.emplace(reader, std::move(callback));
+  reader->set_listener(impl_.get());
+}
+
+int DdsNode::matchedWriters() const { return impl_->matched.load(); }
+
+}  // namespace coloc::rsu_client

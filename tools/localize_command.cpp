@@ -1,0 +1,133 @@
+// `coloc localize`: the vehicle pipeline live over DDS, with a status line per second; on SIGINT or
+// SIGTERM it stops cleanly and writes fused.tum and summary.json as `coloc fuse` does.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "coloc/core/error.hpp"
+#include "coloc/io/trajectory_file.hpp"
+#include "coloc/live/live_localizer.hpp"
+#include "commands.hpp"
+#include "dds_options.hpp"
+#include "teardown_watchdog.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void requestStop(int) { g_stop = true; }
+
+std::uint64_t accepted(const pipeline::PipelineReport& r) {
+  std::uint64_t n = 0;
+  for (const auto& [id, c] : r.fixes) n += c.accepted;
+  return n;
+}
+
+void printStatus(const live::LiveStatus& s, double elapsed) {
+  std::printf("[%6.1f s] ", elapsed);
+  if (s.estimate) {
+    const auto& e = *s.estimate;
+    std::printf("t=%s x=%.3f y=%.3f yaw=%.2f deg sd=%.3f m v=%.2f m/s", formatSeconds(e.stamp).c_str(), e.pose.position.x(),
+                e.pose.position.y(), rollPitchYaw(e.pose.orientation)[2] * 180.0 / M_PI,
+                std::sqrt(std::max(0.0, e.pose_covariance(0, 0) + e.pose_covariance(1, 1))), e.linear_velocity.x());
+  } else {
+    std::printf("not initialised (waiting for an initial pose or a pose source)");
+  }
+  std::printf(" | published %llu", (unsigned long long)s.published);
+  if (s.report.ndt_used)
+    std::printf(" | ndt %llu/%llu", (unsigned long long)s.report.ndt.poses, (unsigned long long)s.report.ndt.scans);
+  if (!s.report.fixes.empty()) {
+    std::uint64_t received = 0;
+    for (const auto& [id, c] : s.report.fixes) received += c.received;
+    std::printf(" | fixes %llu/%llu", (unsigned long long)accepted(s.report), (unsigned long long)received);
+  }
+  std::printf(" | rejected %llu | writers %d\n", (unsigned long long)s.report.rejections, s.matched_writers);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+void addLocalizeCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("localize", "Localize live over DDS: scans, twist and RSU fixes in, the fused pose out (ROS 2 names and QoS)");
+  static std::string map, config_path, registry, out_dir = "coloc_live";
+  static bool sim_time = false;
+  static double duration = 0.0, idle = 0.0;
+  static DdsOptions dds;
+  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles) for NDT")->required();
+  cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`; topics in its live: section)")->check(CLI::ExistingFile);
+  cmd->add_option("--rsu-registry", registry, "RSU registry (YAML): whose fixes to subscribe to and accept (default: rsu.registry of the config)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", out_dir, "where fused.tum and summary.json go when it stops")->capture_default_str();
+  cmd->add_flag("--use-sim-time", sim_time, "run on the time received on /clock (as a ROS 2 node with use_sim_time, for `coloc play`)");
+  cmd->add_option("--duration", duration, "stop after this many seconds (0 = until SIGINT or SIGTERM)");
+  cmd->add_option("--idle-exit", idle, "stop once no input arrived for this many seconds, after the first (0 = never)");
+  cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
+  addDdsOptions(cmd, dds);
+  cmd->callback([] {
+    live::LiveOptions options;
+    if (!config_path.empty()) options.config = pipeline::loadConfig(config_path);
+    if (!registry.empty()) options.registry = rsu_client::RsuRegistry::load(registry);
+    if (dds.reliable) options.config.live.reliable = true;
+    options.map = map;
+    options.use_sim_time = sim_time;
+    options.dds = ddsConfig(dds, "coloc_localizer");
+    printSecurity(options.dds);
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    std::signal(SIGINT, requestStop);
+    std::signal(SIGTERM, requestStop);
+
+    TeardownWatchdog watchdog("localize");
+    watchdog.arm(1);  // a participant that fails to come up is deleted at once
+    live::LiveLocalizer localizer(options);
+    watchdog.disarm();
+    const TeardownWatchdog::ArmOnExit arm_on_exit(watchdog);
+    std::printf("localizing: scans %s, twist %s (%s), initial pose %s; out %s and %s; domain %d%s\n", options.config.live.scan_topic.c_str(),
+                options.config.live.twist_topic.c_str(), options.config.live.twist_type.c_str(), options.config.live.initial_pose_topic.c_str(),
+                options.config.live.pose_topic.c_str(), options.config.live.odometry_topic.c_str(), options.dds.domain,
+                sim_time ? "; time from /clock" : "");
+    std::fflush(stdout);
+
+    const auto start = std::chrono::steady_clock::now();
+    auto last_status = start;
+    auto last_input = start;
+    std::uint64_t inputs_seen = 0;
+    while (!g_stop.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const auto now = std::chrono::steady_clock::now();
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const live::LiveStatus s = localizer.status();
+      std::uint64_t inputs = 0;
+      for (const auto& t : s.topics) inputs += t.received;
+      if (inputs != inputs_seen) inputs_seen = inputs, last_input = now;
+      if (now - last_status >= std::chrono::seconds(1)) {
+        last_status = now;
+        printStatus(s, elapsed);
+      }
+      if (duration > 0.0 && elapsed >= duration) break;
+      if (idle > 0.0 && inputs_seen > 0 && std::chrono::duration<double>(now - last_input).count() >= idle) break;
+    }
+    localizer.stop();
+    io::writeTumTrajectory(out_dir + "/fused.tum", localizer.trajectory(),
+                           "coloc fused trajectory (live)\nt x y z qx qy qz qw (t: header-stamp clock, s)");
+    std::ofstream(out_dir + "/summary.json") << localizer.summaryJson();
+    const live::LiveStatus s = localizer.status();
+    std::printf("stopped%s: %zu estimates written to %s/fused.tum; summary.json beside it\n", g_stop.load() ? " on a signal" : "",
+                localizer.trajectory().size(), out_dir.c_str());
+    for (const auto& t : s.topics)
+      std::printf("  %-48s %8llu messages %6llu undecodable%s%s\n", t.topic.c_str(), (unsigned long long)t.received,
+                  (unsigned long long)t.undecodable, t.first_error.empty() ? "" : "  first: ", t.first_error.c_str());
+    for (const auto& [id, c] : s.report.fixes)
+      std::printf("  RSU %s: %llu fixes received, %llu accepted\n", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted);
+    for (const auto& line : s.report.first_rejections) std::printf("  rejected: %s\n", line.c_str());
+    std::fflush(stdout);
+  });
+}
+
+}  // namespace coloc::tools
