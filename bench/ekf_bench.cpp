@@ -17,7 +17,7 @@
 
 #include "augmented_state_ekf.hpp"
 #include "coloc/fusion/localizer.hpp"
-#include "coloc/fusion/measurement_record.hpp"
+#include "measurement_record.hpp"
 #include "measurements.hpp"
 
 namespace {

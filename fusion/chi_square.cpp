@@ -1,4 +1,4 @@
-#include "coloc/fusion/chi_square.hpp"
+#include "chi_square.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -6,9 +6,9 @@
 #include <unordered_map>
 
 #include "coloc/core/error.hpp"
-#include "coloc/fusion/chi_square.hpp"
-#include "coloc/fusion/measurement_record.hpp"
-#include "coloc/fusion/state_history.hpp"
+#include "chi_square.hpp"
+#include "measurement_record.hpp"
+#include "state_history.hpp"
 
 namespace coloc::fusion {
 
@@ -332,7 +332,7 @@ struct Localizer::Impl {
     if (initialized) {
       const std::int64_t ticks = (now - history.latestStamp()) / history.options().step;
       if (ticks > kMaxTicksPerAdvance)
-        return report(Verdict{Outcome::kRejected, Reason::kClockBackwards, InputKind::kClock, "", now, -1, 0.0,
+        return report(Verdict{Outcome::kRejected, Reason::kClockJump, InputKind::kClock, "", now, -1, 0.0,
                               "a jump of " + formatSeconds(now - history.latestStamp()) +
                                   " s would need more than 10 million prediction ticks; initialise the filter again"});
     }

@@ -1,10 +1,10 @@
-#include "coloc/fusion/measurement_record.hpp"
+#include "measurement_record.hpp"
 
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <sstream>
 
-#include "coloc/fusion/motion_model.hpp"
+#include "motion_model.hpp"
 
 namespace coloc::fusion {
 

@@ -1,9 +1,9 @@
-#include "coloc/fusion/measurement_update.hpp"
+#include "measurement_update.hpp"
 
 #include <Eigen/Cholesky>
 #include <cmath>
 
-#include "coloc/fusion/motion_model.hpp"
+#include "motion_model.hpp"
 
 namespace coloc::fusion {
 
@@ -104,7 +104,10 @@ double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) 
   const Innovation in = innovation(state, record, 1.0);
   Eigen::Matrix<double, 3, 1> solved = Eigen::Matrix<double, 3, 1>::Zero();
   if (!solveSpd<1>(in.S, in.m, in.e, solved)) return kInfinity;
-  return in.e.head(in.m).dot(solved.head(in.m));
+  // A plain loop over the measured rows: GCC's array-bounds analysis misreads head(m).dot() on fixed 3-vectors.
+  double d2 = 0.0;
+  for (int i = 0; i < in.m; ++i) d2 += in.e[i] * solved[i];
+  return d2;
 }
 
 bool applyUpdate(FilterState& state, const UpdateRecord& record) {

@@ -1,4 +1,4 @@
-#include "coloc/fusion/motion_model.hpp"
+#include "motion_model.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "coloc/fusion/state_history.hpp"
+#include "state_history.hpp"
 
 #include <stdexcept>
 

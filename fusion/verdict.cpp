@@ -23,6 +23,7 @@ const char* toString(Reason reason) {
     case Reason::kFromFuture: return "from_future";
     case Reason::kGated: return "gated";
     case Reason::kClockBackwards: return "clock_backwards";
+    case Reason::kClockJump: return "clock_jump";
     case Reason::kNumerical: return "numerical";
   }
   return "?";

@@ -101,6 +101,8 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
     ++report.loops;
     if (options.stop_requested && options.stop_requested()) break;
   }
+  // Reliable readers get everything before the writers go: deleting a writer drops what is unacknowledged.
+  for (auto& [topic, writer] : writers) writer.waitForAcknowledgments(5.0);
   report.wall_seconds = std::chrono::duration<double>(SteadyClock::now() - wall_start).count();
   if (options.progress) options.progress(1.0);
   return report;

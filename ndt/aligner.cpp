@@ -57,8 +57,11 @@ Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen
     // The Newton step (pseudo-inverse, as PCL), turned uphill if it points down. Where the Hessian is
     // indefinite this still aims at the model's stationary point in most directions, which converges far
     // faster than shifting the Hessian towards a gradient step.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12 misreads Eigen's JacobiSVD internals
     Eigen::JacobiSVD<Matrix6d> svd(current.hessian, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Vector6d step = svd.solve(-current.gradient);
+#pragma GCC diagnostic pop
     if (!step.allFinite() || step.norm() == 0.0) {
       out.converged = true;
       break;

@@ -101,6 +101,13 @@ bool DdsNode::Writer::write(const std::uint8_t* data, std::size_t size) {
   return impl_->writer->write(&impl_->staging);
 }
 
+bool DdsNode::Writer::waitForAcknowledgments(double timeout_seconds) {
+  if (!impl_ || !impl_->writer) return false;
+  const auto whole = static_cast<std::int32_t>(timeout_seconds);
+  const auto nanos = static_cast<std::uint32_t>((timeout_seconds - whole) * 1e9);
+  return impl_->writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(whole, nanos)) == ReturnCode_t::RETCODE_OK;
+}
+
 int DdsNode::Writer::matchedReaders() const { return impl_ ? impl_->listener.matched.load() : 0; }
 
 struct DdsNode::Impl : public dds::DataReaderListener {

@@ -18,6 +18,7 @@
 #include "PoseWithCovarianceStampedPubSubTypes.h"
 #include "VehicleDimensionsPubSubTypes.h"
 #include "coloc/core/error.hpp"
+#include "coloc/core/types.hpp"
 #include "dds_participant.hpp"
 
 namespace coloc::rsu_client {
@@ -103,7 +104,7 @@ struct FixSubscriber::Impl : public dds::DataReaderListener {
       const double yaw_variance = msg.pose().covariance()[35];
       if (std::isfinite(yaw_variance) && yaw_variance > 0.0) {
         const auto& q = msg.pose().pose().orientation();
-        fix.yaw = std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()), 1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+        fix.yaw = rollPitchYaw(Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()))[2];
       }
       callback(fix, received);
     }

@@ -106,15 +106,18 @@ void writePlots(const ReplayResult& r, const std::string& dir, const std::string
 
 void addFuseCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("fuse", "Fuse a recorded ROS 2 log (.mcap, .db3 or rosbag2 folder) and write the trajectory");
-  static std::string log, config_path, map, out_dir = "coloc_out";
+  static std::string log, config_path, map, registry, out_dir = "coloc_out";
   cmd->add_option("LOG", log, "the recording")->required();
   cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`)")->check(CLI::ExistingFile);
   cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles): PointCloud2 topics then feed NDT");
+  cmd->add_option("--rsu-registry", registry, "RSU registry (YAML): /rsu/<id>/fix topics of its RSUs pass its checks (default: rsu.registry of the config)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
   cmd->callback([] {
     ReplayOptions options;
     if (!config_path.empty()) options.config = pipeline::loadConfig(config_path);
     options.map = map;
+    if (!registry.empty()) options.registry = rsu_client::RsuRegistry::load(registry);
     ProgressBar progress("fusing");
     options.progress = [&](double f) { progress.update(f); };
     const ReplayResult result = replayLog(log, options);

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "augmented_state_ekf.hpp"
-#include "coloc/fusion/measurement_record.hpp"
+#include "measurement_record.hpp"
 #include "drive.hpp"
 
 namespace coloc::fusion {

@@ -132,6 +132,15 @@ TEST(BadInput, ClockGoingBackwardsIsRejectedAndStateUnchanged) {
   EXPECT_TRUE(snapshot(localizer) == before);
 }
 
+TEST(BadInput, AClockJumpFarAheadIsRejectedAsAJumpNotAsGoingBackwards) {
+  Localizer localizer = drivenLocalizer();
+  const Snapshot before = snapshot(localizer);
+  const Verdict v = localizer.advanceTo(kStart + 400'000 * kNanosPerSecond);  // ~4.6 days of 50 Hz ticks
+  EXPECT_EQ(v.reason, Reason::kClockJump);
+  EXPECT_NE(v.message().find("prediction ticks"), std::string::npos) << v.message();
+  EXPECT_TRUE(snapshot(localizer) == before);
+}
+
 TEST(BadInput, MeasurementsBeforeInitialisationAreCountedNotApplied) {
   EkfConfig config;  // auto-initialisation on: a planar pose would start the filter, these cannot
   Localizer localizer(config);

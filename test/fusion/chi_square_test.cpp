@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "coloc/fusion/chi_square.hpp"
+#include "chi_square.hpp"
 
 namespace coloc::fusion {
 namespace {

@@ -22,10 +22,10 @@ TEST(EkfParams, FormatsDefaultsAsTheirYamlText) {
   const EkfConfig defaults;
   for (const EkfParam& p : ekfParams()) {
     const std::string key = p.key;
-    if (key == "predict_frequency") EXPECT_EQ(formatValue(p, defaults), "50.0");
-    if (key == "history_steps") EXPECT_EQ(formatValue(p, defaults), "50");
-    if (key == "pose_gate_alpha") EXPECT_EQ(formatValue(p, defaults), "1e-10");
-    if (key == "auto_initialize") EXPECT_EQ(formatValue(p, defaults), "true");
+    if (key == "predict_frequency") { EXPECT_EQ(formatValue(p, defaults), "50.0"); }
+    if (key == "history_steps") { EXPECT_EQ(formatValue(p, defaults), "50"); }
+    if (key == "pose_gate_alpha") { EXPECT_EQ(formatValue(p, defaults), "1e-10"); }
+    if (key == "auto_initialize") { EXPECT_EQ(formatValue(p, defaults), "true"); }
   }
 }
 

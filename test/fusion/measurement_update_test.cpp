@@ -2,9 +2,9 @@
 
 #include <cstring>
 
-#include "coloc/fusion/measurement_record.hpp"
-#include "coloc/fusion/measurement_update.hpp"
-#include "coloc/fusion/motion_model.hpp"
+#include "measurement_record.hpp"
+#include "measurement_update.hpp"
+#include "motion_model.hpp"
 #include "measurements.hpp"
 
 namespace coloc::fusion {

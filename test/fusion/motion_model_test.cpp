@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "coloc/fusion/motion_model.hpp"
+#include "motion_model.hpp"
 
 namespace coloc::fusion {
 namespace {

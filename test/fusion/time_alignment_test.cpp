@@ -32,7 +32,7 @@ double offTickFixes(bool align, int late, int every, int until, int ticks, Eigen
       due.push_back({k + 1 + late, fix2d(kStart + k * kTick + fromSeconds(kOffset), p.x(), p.y(), 1e-4)});
     }
     for (auto& [at, fix] : due)
-      if (at == k) EXPECT_TRUE(localizer.feedPose("rsu", fix).applied());
+      if (at == k) { EXPECT_TRUE(localizer.feedPose("rsu", fix).applied()); }
   }
   const Estimate e = *localizer.estimate();
   if (final_position) *final_position = e.state.head<2>();

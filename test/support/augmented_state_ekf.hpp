@@ -9,7 +9,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "coloc/fusion/motion_model.hpp"
+#include "motion_model.hpp"
 
 namespace coloc::testing {
 

@@ -18,6 +18,7 @@ enum class Reason : std::uint8_t {
   kFromFuture,       ///< stamp ahead of the caller's clock beyond the tolerance
   kGated,            ///< Mahalanobis gate refused it
   kClockBackwards,   ///< advanceTo with an earlier time than before
+  kClockJump,        ///< advanceTo so far ahead that the prediction would need millions of ticks
   kNumerical,        ///< innovation covariance not positive definite
 };
 

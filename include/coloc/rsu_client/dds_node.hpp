@@ -37,6 +37,9 @@ class DdsNode {
     bool write(const std::uint8_t* data, std::size_t size);
     bool write(const std::vector<std::uint8_t>& bytes) { return write(bytes.data(), bytes.size()); }
     int matchedReaders() const;
+    /// Reliable writers: waits until every matched reader acknowledged what was written (or the
+    /// timeout passes; false then). A writer deleted earlier takes unacknowledged samples with it.
+    bool waitForAcknowledgments(double timeout_seconds);
 
    private:
     friend class DdsNode;

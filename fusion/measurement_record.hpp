@@ -5,7 +5,7 @@
 #include <variant>
 
 #include "coloc/core/types.hpp"
-#include "coloc/fusion/measurement_update.hpp"
+#include "measurement_update.hpp"
 
 namespace coloc::fusion {
 

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "coloc/fusion/filter_state.hpp"
-#include "coloc/fusion/measurement_update.hpp"
-#include "coloc/fusion/motion_model.hpp"
+#include "measurement_update.hpp"
+#include "motion_model.hpp"
 
 namespace coloc::fusion {
 

@@ -1,0 +1,21 @@
+# Installs the build tree into a scratch prefix, then configures, builds and runs an example project
+# against it, as a vehicle stack would: cmake -DSOURCE_DIR=.. -DBUILD_DIR=.. -DWORK_DIR=.. -DEXAMPLE=vehicle_stack -P this file.
+file(REMOVE_RECURSE "${WORK_DIR}")
+execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix" RESULT_VARIABLE rc OUTPUT_QUIET)
+if(rc)
+  message(FATAL_ERROR "install failed: ${rc}")
+endif()
+execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/examples/${EXAMPLE}" -B "${WORK_DIR}/build"
+                        "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix" -DCMAKE_BUILD_TYPE=Release RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "example configure failed: ${rc}")
+endif()
+execute_process(COMMAND "${CMAKE_COMMAND}" --build "${WORK_DIR}/build" RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "example build failed: ${rc}")
+endif()
+execute_process(COMMAND "${WORK_DIR}/build/${EXAMPLE}" RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+message("${out}")
+if(rc)
+  message(FATAL_ERROR "example run failed: ${rc}")
+endif()
