@@ -102,6 +102,20 @@ std::vector<double> YamlReader::numbers(const YAML::Node& node, const std::strin
   return v;
 }
 
+std::vector<double> YamlReader::numberList(const YAML::Node& node, const std::string& key, double lo, double hi) const {
+  if (!node.IsSequence() || node.size() == 0) fail(node, key, "expected a non-empty list of numbers");
+  std::vector<double> v;
+  for (const auto& e : node) v.push_back(inRange(e, key, lo, hi));
+  return v;
+}
+
+std::vector<std::string> YamlReader::textList(const YAML::Node& node, const std::string& key) const {
+  if (!node.IsSequence() || node.size() == 0) fail(node, key, "expected a non-empty list");
+  std::vector<std::string> v;
+  for (const auto& e : node) v.push_back(text(e, key));
+  return v;
+}
+
 void YamlReader::requireMap(const YAML::Node& node, const std::string& key) const {
   if (!node.IsMap()) fail(node, key, "expected a mapping of keys to values");
 }

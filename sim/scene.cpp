@@ -4,77 +4,33 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
-#include "coloc/core/config_error.hpp"
+#include "coloc/core/error.hpp"
+#include "coloc/core/yaml_reader.hpp"
 #include "coloc/sim/vehicle_body.hpp"
 
 namespace coloc::sim {
 
 namespace {
 
-class Reader {
+// The one YAML reader, with the scene's shapes on top; every scenario value must be finite.
+class Reader : public YamlReader {
  public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& why) const {
-    throwConfigError(source_, n.Mark().line, key, why);
-  }
-  double number(const YAML::Node& n, const std::string& key) const {
-    try {
-      const double v = n.as<double>();
-      if (!std::isfinite(v)) fail(n, key, "must be finite");
-      return v;
-    } catch (const YAML::Exception&) {
-      fail(n, key, "expected a number");
-    }
-  }
-  double positive(const YAML::Node& n, const std::string& key) const {
-    const double v = number(n, key);
-    if (v <= 0.0) fail(n, key, "must be > 0");
-    return v;
-  }
+  using YamlReader::YamlReader;
+  double number(const YAML::Node& n, const std::string& key) const { return finite(n, key); }
   Eigen::Vector2d vec2(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsSequence() || n.size() != 2) fail(n, key, "expected [x, y]");
-    return {number(n[0], key), number(n[1], key)};
+    const auto v = numbers(n, key, 2, "[x, y]");
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1])) fail(n, key, "must be finite");
+    return {v[0], v[1]};
   }
   Eigen::Vector3d vec3(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsSequence() || n.size() != 3) fail(n, key, "expected [x, y, z]");
-    return {number(n[0], key), number(n[1], key), number(n[2], key)};
+    const auto v = numbers(n, key, 3, "[x, y, z]");
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) fail(n, key, "must be finite");
+    return {v[0], v[1], v[2]};
   }
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    try {
-      return n.as<std::string>();
-    } catch (const YAML::Exception&) {
-      fail(n, key, "expected a string");
-    }
-  }
-  bool flag(const YAML::Node& n, const std::string& key) const {
-    try {
-      return n.as<bool>();
-    } catch (const YAML::Exception&) {
-      fail(n, key, "expected true or false");
-    }
-  }
-  void keys(const YAML::Node& n, const std::string& where, std::initializer_list<const char*> allowed) const {
-    if (!n.IsMap()) fail(n, where, "expected a mapping");
-    for (const auto& e : n) {
-      const std::string k = e.first.as<std::string>();
-      bool ok = false;
-      std::string list;
-      for (const char* a : allowed) {
-        ok = ok || k == a;
-        list += std::string(list.empty() ? "" : ", ") + a;
-      }
-      if (!ok) fail(e.first, where + "." + k, "unknown key (" + list + ")");
-    }
-  }
-  const YAML::Node require(const YAML::Node& n, const char* key, const std::string& where) const {
-    if (!n[key]) fail(n, where, std::string("needs ") + key);
-    return n[key];
-  }
-
- private:
-  std::string source_;
+  void keys(const YAML::Node& n, const std::string& where, std::initializer_list<const char*> allowed) const { allowKeys(n, where, allowed); }
 };
 
 SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& where) {
@@ -129,16 +85,11 @@ SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& 
 
 Scenario parseScenario(const std::string& yaml_text, const std::string& source) {
   const Reader r(source);
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw Error(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = r.parse(yaml_text);
   r.keys(root, "(top level)", {"name", "seed", "ground", "objects", "route", "vehicle", "rsus"});
   Scenario s;
   s.name = root["name"] ? r.text(root["name"], "name") : "scenario";
-  if (root["seed"]) s.seed = root["seed"].as<std::uint64_t>();
+  if (root["seed"]) s.seed = static_cast<std::uint64_t>(r.integer(root["seed"], "seed", 0, std::numeric_limits<long long>::max()));
   if (root["ground"]) {
     r.keys(root["ground"], "ground", {"min", "max"});
     s.ground_min = r.vec2(r.require(root["ground"], "min", "ground"), "ground.min");

@@ -28,7 +28,7 @@ TEST(Scenario, ShippedSiteALoadsWithAMapThatDiffersFromTheWorld) {
 TEST(Scenario, ErrorsNameTheKeyAndLine) {
   expectError(std::string("objects:\n  - {type: fountain, at: [0, 0]}\n") + kRoute, "s.yaml:2: objects[0].type: unknown object type 'fountain'");
   expectError(std::string("objects:\n  - {type: pole, at: [0, 0], height: 5, colour: red}\n") + kRoute, "objects[0].colour: unknown key");
-  expectError(std::string("objects:\n  - {type: wall, from: [0, 0], to: [1, 0], height: -2}\n") + kRoute, "must be > 0");
+  expectError(std::string("objects:\n  - {type: wall, from: [0, 0], to: [1, 0], height: -2}\n") + kRoute, "objects[0].height: must be a finite number > 0");
   expectError("route: {start: [0, 0], pieces: []}\n", "expected a list of {length, curvature}");
   expectError(std::string(kRoute) + "vehicle: {lidar: HDL-64}\n", "unknown LiDAR model 'HDL-64'");
   expectError(std::string(kRoute) + "weather: rain\n", "weather: unknown key");

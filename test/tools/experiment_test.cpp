@@ -39,10 +39,10 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_EQ(errorOf("trials: 3\ntrails: 4\n").rfind("exp.yaml:2: trails: unknown key", 0), 0u) << errorOf("trails: 4");
   EXPECT_NE(errorOf("trials: 0\n").find("exp.yaml:1: trials: must be in [1, 1000]"), std::string::npos);
   EXPECT_NE(errorOf("lidars: [VLP-64]\n").find("unknown LiDAR model 'VLP-64'"), std::string::npos);
-  EXPECT_NE(errorOf("losses: [0.0, .nan]\n").find("losses: must be in"), std::string::npos);
+  EXPECT_NE(errorOf("losses: [0.0, .nan]\n").find("losses: must not be NaN"), std::string::npos);
   EXPECT_NE(errorOf("delays: [0.01, 0.03]\n").find("the ideal network is the reference"), std::string::npos);
   EXPECT_NE(errorOf("- a list\n").find("expected a mapping"), std::string::npos);
-  EXPECT_NE(errorOf("rsu_covariance: guessed\n").find("exp.yaml:1: rsu_covariance: expected published, standard_deviation or estimated"),
+  EXPECT_NE(errorOf("rsu_covariance: guessed\n").find("exp.yaml:1: rsu_covariance: expected one of published, standard_deviation, estimated"),
             std::string::npos);
   EXPECT_EQ(parseExperimentConfig("rsu_covariance: estimated\n", "exp.yaml").rsu_covariance, RsuCovariance::kEstimated);
 }

@@ -38,6 +38,11 @@ class YamlReader {
   /// A list of exactly `count` numbers (NaN refused, .inf allowed); `shape` describes it, e.g. "[x, y]".
   std::vector<double> numbers(const YAML::Node& node, const std::string& key, std::size_t count, const std::string& shape) const;
 
+  /// A non-empty list of numbers, each within [lo, hi].
+  std::vector<double> numberList(const YAML::Node& node, const std::string& key, double lo, double hi) const;
+  /// A non-empty list of strings.
+  std::vector<std::string> textList(const YAML::Node& node, const std::string& key) const;
+
   void requireMap(const YAML::Node& node, const std::string& key) const;
   /// Fails on the first key of the mapping `node` that is not in `allowed`, listing the allowed ones.
   void allowKeys(const YAML::Node& node, const std::string& where, std::initializer_list<const char*> allowed) const;
