@@ -52,9 +52,6 @@ double rangeOf(const std::string& lidar) {
   return m ? m->range : 0.0;
 }
 
-bool isMain(const ExperimentRun& r) { return r.variant.empty(); }
-bool isIdeal(const ExperimentRun& r) { return r.delay == 0.0 && r.loss == 0.0; }
-
 const ExperimentRun* find(const std::vector<ExperimentRun>& runs, const std::string& site, int trial, const std::string& lidar,
                           double delay, double loss, const std::string& variant) {
   for (const ExperimentRun& r : runs)
