@@ -5,10 +5,12 @@
 #include <filesystem>
 
 #include "commands.hpp"
-#include "experiment.hpp"
-#include "experiment_report.hpp"
+#include "coloc/twin/experiment.hpp"
+#include "coloc/twin/experiment_report.hpp"
 
 namespace coloc::tools {
+
+using namespace coloc::twin;
 
 void addExperimentCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("experiment",

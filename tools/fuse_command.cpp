@@ -10,7 +10,7 @@
 #include "commands.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "progress.hpp"
-#include "svg_plot.hpp"
+#include "coloc/replay/svg_plot.hpp"
 
 namespace coloc::tools {
 

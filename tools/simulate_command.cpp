@@ -5,9 +5,11 @@
 #include "coloc/sim/scene.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
-#include "twin_recording.hpp"
+#include "coloc/twin/twin_recording.hpp"
 
 namespace coloc::tools {
+
+using namespace coloc::twin;
 
 void addSimulateCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("simulate", "Drive the digital twin through a scenario and record a rosbag2 log");

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "experiment_config.hpp"
+#include "coloc/twin/experiment_config.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
 
 /// One replay: which site, trial and configuration, and the error along the road.
 struct ExperimentRun {
@@ -62,4 +62,4 @@ struct ExperimentProgress {
 /// bad scenarios or unwritable folders.
 ExperimentResults runExperiment(const ExperimentConfig& config, const std::string& out_dir, const ExperimentProgress& progress);
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace coloc::tools {
+namespace coloc::twin {
 
 /// How the fused RSU fixes' covariance is set: as the paper publishes it (its sigma figure in the
 /// variance's place, 0.01486 / 0.00681 m^2), that figure read as a standard deviation (variance =
@@ -56,4 +56,4 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
 /// The scenario's YAML text: a built-in one by name, else the file.
 std::string scenarioText(const std::string& site);
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -6,10 +6,10 @@
 #include "builtin_scenarios.hpp"
 #include "coloc/core/error.hpp"
 #include "coloc/sim/scene.hpp"
-#include "experiment_config.hpp"
-#include "experiment_report.hpp"
+#include "coloc/twin/experiment_config.hpp"
+#include "coloc/twin/experiment_report.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
 namespace {
 
 std::string errorOf(const std::string& yaml) {
@@ -89,4 +89,4 @@ TEST(ErrorInCoverage, PaperMetricIsTheMeanOfEachBinsMinimumAndIgnoresTheRestOfTh
 }
 
 }  // namespace
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -1,4 +1,4 @@
-#include "svg_plot.hpp"
+#include "coloc/replay/svg_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "coloc/core/error.hpp"
 
-namespace coloc::tools {
+namespace coloc::replay {
 
 namespace {
 
@@ -158,4 +158,4 @@ void writeSvg(const std::string& path, const Plot& plot) {
   if (!out) throw Error(path + ": write failed");
 }
 
-}  // namespace coloc::tools
+}  // namespace coloc::replay

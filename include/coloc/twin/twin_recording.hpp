@@ -14,7 +14,7 @@
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/scene.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
 
 struct TwinRecordingOptions {
   std::string out_dir;             ///< must be empty or absent
@@ -44,4 +44,4 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
 /// A scenario RSU as the vehicle's registry lists it (surveyed position, model, coverage, identity).
 rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& rsu);
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

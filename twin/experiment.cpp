@@ -1,4 +1,4 @@
-#include "experiment.hpp"
+#include "coloc/twin/experiment.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -19,9 +19,9 @@
 #include "coloc/pipeline/config.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
-#include "twin_recording.hpp"
+#include "coloc/twin/twin_recording.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
 
 namespace {
 
@@ -374,4 +374,4 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   return results;
 }
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -1,4 +1,4 @@
-#include "experiment_config.hpp"
+#include "coloc/twin/experiment_config.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -11,7 +11,7 @@
 #include "coloc/core/yaml_reader.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
 
 const char* toString(RsuCovariance c) {
   switch (c) {
@@ -89,4 +89,4 @@ std::string scenarioText(const std::string& site) {
   return text.str();
 }
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -5,9 +5,9 @@
 // grid) as SVG with the CSV behind each; and a README that puts them together.
 #include <string>
 
-#include "experiment.hpp"
+#include "coloc/twin/experiment.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
 
 struct ErrorInCoverage {
   double paper = 0.0;  ///< mean over the road's bins of the minimum error in each bin, m
@@ -21,4 +21,4 @@ ErrorInCoverage errorInCoverage(const ExperimentRun& run, double range, double b
 /// Writes tables, figures, CSVs and README.md into out_dir; returns Table I as Markdown.
 std::string writeExperimentReport(const ExperimentResults& results, const std::string& out_dir, const std::string& command_line);
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

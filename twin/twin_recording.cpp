@@ -1,4 +1,4 @@
-#include "twin_recording.hpp"
+#include "coloc/twin/twin_recording.hpp"
 
 #include <array>
 #include <chrono>
@@ -21,9 +21,14 @@
 #include "coloc/sim/roadside_perception.hpp"
 #include "coloc/sim/survey_map.hpp"
 #include "coloc/sim/vehicle_body.hpp"
-#include "svg_plot.hpp"
+#include "coloc/replay/svg_plot.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
+
+using replay::Plot;
+using replay::PlotBand;
+using replay::PlotSeries;
+using replay::writeSvg;
 
 namespace {
 
@@ -334,4 +339,4 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   return summary;
 }
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "svg_plot.hpp"
+#include "coloc/replay/svg_plot.hpp"
 
-namespace coloc::tools {
+namespace coloc::replay {
 namespace {
 
 TEST(SvgPlot, RendersSeriesLegendAndBandsAsValidSvg) {
@@ -32,4 +32,4 @@ TEST(SvgPlot, EmptyAndNonFiniteDataDoNotBreakTheAxes) {
 }
 
 }  // namespace
-}  // namespace coloc::tools
+}  // namespace coloc::replay

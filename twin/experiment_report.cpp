@@ -1,4 +1,4 @@
-#include "experiment_report.hpp"
+#include "coloc/twin/experiment_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,9 +10,14 @@
 
 #include "coloc/core/error.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
-#include "svg_plot.hpp"
+#include "coloc/replay/svg_plot.hpp"
 
-namespace coloc::tools {
+namespace coloc::twin {
+
+using replay::Plot;
+using replay::PlotBand;
+using replay::PlotSeries;
+using replay::writeSvg;
 
 namespace {
 
@@ -357,4 +362,4 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   return table1.str();
 }
 
-}  // namespace coloc::tools
+}  // namespace coloc::twin

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace coloc::tools {
+namespace coloc::replay {
 
 struct PlotSeries {
   std::string label;
@@ -33,4 +33,4 @@ std::string renderSvg(const Plot& plot);
 /// Throws coloc::Error naming the file if it cannot be written.
 void writeSvg(const std::string& path, const Plot& plot);
 
-}  // namespace coloc::tools
+}  // namespace coloc::replay
