@@ -172,7 +172,10 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
     if (result.topics[i].role == InputRole::kTwist) source_of[i] = pipe.addTwistSource(result.topics[i].source);
   }
   pipe.onEstimate([&](const fusion::Estimate& e) { result.fused.push_back({e.stamp, e.pose}); });
-  pipe.onPoseInput([&](const std::string&, const PoseMeasurement& p) { result.pose_inputs.push_back({p.stamp, p.pose}); });
+  pipe.onPoseInput([&](const std::string& source, const PoseMeasurement& p) {
+    result.pose_inputs.push_back({p.stamp, p.pose});
+    result.pose_input_sources.push_back(source);
+  });
   pipe.onRejection([&](const std::string& line) {
     if (result.rejections.size() < 20) result.rejections.push_back(line);
   });
@@ -221,7 +224,16 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   }
   std::sort(result.ground_truth.begin(), result.ground_truth.end(),
             [](const io::TrajectoryPoint& a, const io::TrajectoryPoint& b) { return a.stamp < b.stamp; });
-  result.errors = evaluate(result.fused, result.ground_truth, fromSeconds(config.replay.ground_truth_max_gap));
+  const Duration max_gap = fromSeconds(config.replay.ground_truth_max_gap);
+  result.errors = evaluate(result.fused, result.ground_truth, max_gap);
+  if (!result.ground_truth.empty()) {
+    std::map<std::string, std::vector<io::TrajectoryPoint>> by_source;
+    for (std::size_t i = 0; i < result.pose_inputs.size(); ++i) by_source[result.pose_input_sources[i]].push_back(result.pose_inputs[i]);
+    for (auto& [source, inputs] : by_source) {
+      std::sort(inputs.begin(), inputs.end(), [](const io::TrajectoryPoint& a, const io::TrajectoryPoint& b) { return a.stamp < b.stamp; });
+      result.input_errors[source] = evaluate(inputs, result.ground_truth, max_gap);
+    }
+  }
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;
 }

@@ -40,9 +40,20 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
   j["fused"] = {{"file", "fused.tum"}, {"poses", fused.size()}, {"first_stamp", formatSeconds(first_stamp)}, {"last_stamp", formatSeconds(last_stamp)}};
   if (!errors.empty()) {
     const ErrorStats s = errorStats();
-    j["position_error"] = {{"samples", errors.size()}, {"mean_m", s.mean}, {"rmse_m", s.rmse}, {"max_m", s.max}, {"file", "error.csv"}};
+    j["position_error"] = {{"samples", errors.size()}, {"mean_m", s.mean},   {"rmse_m", s.rmse},
+                           {"max_m", s.max},         {"along_mean_m", s.along_mean}, {"across_mean_m", s.across_mean},
+                           {"file", "error.csv"}};
   } else {
     j["position_error"] = nullptr;
+  }
+  if (!input_errors.empty()) {
+    auto& inputs = j["input_error"] = nlohmann::ordered_json::object();
+    for (const auto& [source, samples] : input_errors) {
+      const ErrorStats s = replay::errorStats(samples);
+      inputs[source] = {{"samples", samples.size()}, {"mean_m", s.mean},   {"rmse_m", s.rmse},
+                        {"max_m", s.max},             {"along_mean_m", s.along_mean}, {"across_mean_m", s.across_mean}};
+    }
+    inputs["file"] = "input_error.csv";
   }
   if (ndt_used) j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(ndt, map, scans_without_guess));
   if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes));
@@ -53,13 +64,26 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
 void ReplayResult::writeErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
-  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m\n";
-  char line[256];
+  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m\n";
+  char line[320];
   for (const ErrorSample& s : errors) {
-    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(), s.estimate.y(),
-                  s.truth.x(), s.truth.y(), s.error);
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(),
+                  s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across);
     out << line;
   }
+}
+
+void ReplayResult::writeInputErrorCsv(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot write");
+  out << "stamp_s,source,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m\n";
+  char line[320];
+  for (const auto& [source, samples] : input_errors)
+    for (const ErrorSample& s : samples) {
+      std::snprintf(line, sizeof line, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), source.c_str(),
+                    s.estimate.x(), s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across);
+      out << line;
+    }
 }
 
 }  // namespace coloc::replay

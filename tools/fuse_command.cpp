@@ -65,14 +65,20 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
   }
   if (!r.errors.empty()) {
     const ErrorStats s = r.errorStats();
-    std::printf("\n  position error vs ground truth (%zu ticks): mean %.4f m, RMSE %.4f m, max %.4f m\n", r.errors.size(), s.mean,
-                s.rmse, s.max);
+    std::printf("\n  position error vs ground truth (%zu ticks): mean %.4f m, RMSE %.4f m, max %.4f m; bias %+.4f m along, %+.4f m across\n",
+                r.errors.size(), s.mean, s.rmse, s.max, s.along_mean, s.across_mean);
+    for (const auto& [source, samples] : r.input_errors) {
+      const ErrorStats i = errorStats(samples);
+      std::printf("  %-22s its own poses (%zu): mean %.4f m, RMSE %.4f m; bias %+.4f m along, %+.4f m across\n", source.c_str(),
+                  samples.size(), i.mean, i.rmse, i.along_mean, i.across_mean);
+    }
   } else {
     std::printf("\n  no ground truth in the log: no error figures\n");
   }
   std::printf("  fused %zu poses (%.1f s) in %.3f s: %.0fx real time\n", r.fused.size(), toSeconds(r.last_stamp - r.first_stamp),
               r.wall_seconds, r.wall_seconds > 0 ? r.log_duration / r.wall_seconds : 0.0);
-  std::printf("  wrote %s/{fused.tum, summary.json, trajectory.svg%s}\n", out_dir.c_str(), r.errors.empty() ? "" : ", error.csv, error.svg");
+  std::printf("  wrote %s/{fused.tum, summary.json, trajectory.svg%s}\n", out_dir.c_str(),
+              r.errors.empty() ? "" : ", error.csv, error.svg, input_error.csv");
 }
 
 void writePlots(const ReplayResult& r, const std::string& dir, const std::string& log) {
@@ -133,6 +139,7 @@ void addFuseCommand(CLI::App& app) {
                                      {"speed_x_realtime", result.wall_seconds > 0 ? result.log_duration / result.wall_seconds : 0.0}};
     std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
     if (!result.errors.empty()) result.writeErrorCsv(out_dir + "/error.csv");
+    if (!result.input_errors.empty()) result.writeInputErrorCsv(out_dir + "/input_error.csv");
     writePlots(result, out_dir, log);
     printSummary(log, result, out_dir);
   });

@@ -38,7 +38,7 @@ const fusion::SourceCounters& counters(const ReplayResult& r, const std::string&
 }
 
 TEST(LogReplay, RealNav2RecordingIsFusedFromAmclPosesAndOdometryTwist) {
-  const ReplayResult r = replayLog(nav2(), {});
+  const ReplayResult r = replayLog(nav2(), ReplayOptions());
   EXPECT_EQ(topic(r, "/amcl_pose").role, InputRole::kPose);
   EXPECT_EQ(topic(r, "/odom").role, InputRole::kTwist);
   EXPECT_EQ(topic(r, "/tf").role, InputRole::kIgnore);
@@ -72,8 +72,8 @@ TEST(LogReplay, RealNav2RecordingIsFusedFromAmclPosesAndOdometryTwist) {
 TEST(LogReplay, Sqlite3ConversionOfTheRecordingGivesTheSameFusedOutput) {
   testing::TempDir dir;
   io::convert(nav2(), dir / "nav2");
-  const ReplayResult from_mcap = replayLog(nav2(), {});
-  const ReplayResult from_db3 = replayLog(dir / "nav2", {});
+  const ReplayResult from_mcap = replayLog(nav2(), ReplayOptions());
+  const ReplayResult from_db3 = replayLog(dir / "nav2", ReplayOptions());
   ASSERT_EQ(from_mcap.fused.size(), from_db3.fused.size());
   for (std::size_t i = 0; i < from_mcap.fused.size(); ++i) {
     ASSERT_EQ(from_mcap.fused[i].stamp, from_db3.fused[i].stamp);
@@ -134,7 +134,7 @@ std::string writeSyntheticLog(const testing::TempDir& dir) {
 
 TEST(LogReplay, SyntheticDriveIsFusedAndScoredAgainstItsGroundTruth) {
   testing::TempDir dir;
-  const ReplayResult r = replayLog(writeSyntheticLog(dir), {});
+  const ReplayResult r = replayLog(writeSyntheticLog(dir), ReplayOptions());
   EXPECT_EQ(r.clock, ClockMode::kSame);
   EXPECT_EQ(topic(r, "/ground_truth/odom").role, InputRole::kGroundTruth);
   EXPECT_EQ(topic(r, "/chatter").role, InputRole::kIgnore);
@@ -183,7 +183,7 @@ TEST(LogReplay, ConfiguredRoleOnAnIncompatibleTypeIsAnErrorNamingTheTopic) {
 }
 
 TEST(LogReplay, MissingLogIsAnErrorNamingIt) {
-  EXPECT_THROW(replayLog("/nonexistent/log.mcap", {}), Error);
+  EXPECT_THROW(replayLog("/nonexistent/log.mcap", ReplayOptions()), Error);
 }
 
 }  // namespace
@@ -247,7 +247,7 @@ TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {
     bag.write("/points", 1'000'000'000, b.data(), b.size());
     bag.close();
   }
-  const ReplayResult r = replayLog(dir / "scans", {});
+  const ReplayResult r = replayLog(dir / "scans", ReplayOptions());
   EXPECT_EQ(topic(r, "/points").role, InputRole::kIgnore);
   EXPECT_NE(topic(r, "/points").note.find("--map"), std::string::npos);
 }

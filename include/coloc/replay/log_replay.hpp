@@ -33,6 +33,10 @@ struct ReplayResult {
   std::uint64_t unknown_source_inputs = 0;
   std::vector<io::TrajectoryPoint> fused;          ///< the estimate at every tick
   std::vector<io::TrajectoryPoint> pose_inputs;    ///< every pose measurement fed (NDT, fixes, others), for plots
+  std::vector<std::string> pose_input_sources;     ///< the source of each pose input
+  /// Each pose source's own measurements against ground truth at their stamps (NDT's per-scan error
+  /// beside the fused error: a filter should never be worse than its best input).
+  std::map<std::string, std::vector<ErrorSample>> input_errors;
   std::vector<io::TrajectoryPoint> ground_truth;
   std::vector<ErrorSample> errors;                 ///< at ticks with ground truth
   ClockMode clock = ClockMode::kAuto;              ///< the mode used (never kAuto)
@@ -51,8 +55,10 @@ struct ReplayResult {
   /// Everything that follows from the log and the config, as JSON (summary.json of `coloc fuse`): the
   /// same log and config give the same bytes. `log` is the name to print for the recording.
   std::string summaryJson(const std::string& log) const;
-  /// error.csv: the planar error at every tick with ground truth.
+  /// error.csv: the planar error at every tick with ground truth, split along and across the heading.
   void writeErrorCsv(const std::string& path) const;
+  /// input_error.csv: every pose input's error against ground truth at its stamp, by source.
+  void writeInputErrorCsv(const std::string& path) const;
   ErrorStats errorStats() const { return replay::errorStats(errors); }
 };
 
