@@ -235,6 +235,12 @@ const std::vector<Key>& keys() {
          for (int i = 0; i < 4; ++i)
            if (!std::isfinite(v[i])) r.fail(n[i], k, "must be finite");
          c.pipeline.initial_pose = Eigen::Vector4d(v[0], v[1], v[2], v[3]); }},
+      {"pipeline", "speed_scale_estimation", "", "learn the odometry's speed scale (wheel radius error) from NDT's poses and correct twists by it",
+       [](const C& c) { return S(c.pipeline.speed_scale_estimation ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.speed_scale_estimation = r.flag(n, k); }},
+      {"pipeline", "speed_scale_memory", "m", "travel over which old comparisons of NDT and odometry distance fade to 1/e",
+       [](const C& c) { return show(c.pipeline.speed_scale_memory); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.speed_scale_memory = r.inRange(n, k, 10.0, 1e6); }},
       // ---- messages
       {"messages", "zero_variance_is_unmeasured", "", "read a 0 variance in a message as +inf, as ROS drivers write 0 for what they do not estimate",
        [](const C& c) { return S(c.messages.zero_variance_is_unmeasured ? "true" : "false"); },

@@ -10,6 +10,7 @@
 #include "coloc/core/error.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "inbox.hpp"
+#include "speed_scale.hpp"
 
 namespace coloc::pipeline {
 
@@ -146,6 +147,7 @@ struct Pipeline::Impl {
   fusion::SourceId ndt_id = -1;
   std::optional<rsu_client::FixChecker> checker;
   std::map<std::string, fusion::SourceId> fix_sources;  // by RSU id
+  SpeedScaleEstimator speed_scale;
   bool first_input_seen = false;
   Stamp clock = 0;
   bool clock_set = false;
@@ -167,7 +169,8 @@ struct Pipeline::Impl {
       : config(c),
         step(static_cast<Duration>(std::llround(1e9 / c.fusion.predict_frequency))),
         now(options.clock ? options.clock : std::function<Stamp()>(rsu_client::systemNow)),
-        localizer(c.fusion) {
+        localizer(c.fusion),
+        speed_scale(SpeedScaleConfig{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory}) {
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
       if (v.rejected()) reject(v.message());
     });
@@ -229,16 +232,18 @@ struct Pipeline::Impl {
     clock_set = true;
   }
 
-  void feedPose(fusion::SourceId source, const PoseMeasurement& pose) {
+  fusion::Verdict feedPose(fusion::SourceId source, const PoseMeasurement& pose) {
     if (on_pose_input) on_pose_input(source_names[source], pose);
     const bool was_initialized = localizer.initialized();
-    localizer.feedPose(source, pose);
+    const fusion::Verdict v = localizer.feedPose(source, pose);
     if (!was_initialized && localizer.initialized()) emit(*localizer.estimate());
+    return v;
   }
 
   void handle(const ndt::ScanOutcome& outcome, Stamp scan_stamp) {
-    if (outcome.produced) feedPose(ndt_id, outcome.pose);
-    else reject("scan stamped " + formatSeconds(scan_stamp) + ": " + outcome.detail);
+    if (!outcome.produced) return reject("scan stamped " + formatSeconds(scan_stamp) + ": " + outcome.detail);
+    // NDT's poses, where the filter takes them, anchor the odometry's speed scale.
+    if (!feedPose(ndt_id, outcome.pose).rejected()) speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
   }
 
   void apply(Input& input, Stamp arrival) {
@@ -262,7 +267,13 @@ struct Pipeline::Impl {
     } else if (auto* result = std::get_if<NdtResult>(&input)) {
       handle(result->outcome, result->scan_stamp);
     } else if (auto* twist = std::get_if<TwistInput>(&input)) {
-      localizer.feedTwist(twist->source, twist->twist);
+      // A twist that measures speed (odometry, not an IMU) is scaled by what NDT taught about it.
+      TwistMeasurement t = twist->twist;
+      if (std::isfinite(t.covariance(0, 0))) {
+        speed_scale.addTwist(t.stamp, t.linear.x());
+        t.linear.x() *= speed_scale.scale();
+      }
+      localizer.feedTwist(twist->source, t);
     } else if (auto* pose = std::get_if<PoseInput>(&input)) {
       feedPose(pose->source, pose->pose);
     } else if (auto* fix = std::get_if<FixInput>(&input)) {
@@ -384,6 +395,8 @@ PipelineReport Pipeline::report() const {
   }
   if (impl_->checker)
     for (const auto& [id, c] : impl_->checker->counters()) r.fixes[id] = c;
+  r.speed_scale = impl_->speed_scale.scale();
+  r.speed_scale_distance = impl_->speed_scale.comparedDistance();
   return r;
 }
 

@@ -198,6 +198,8 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   result.map = report.map;
   result.scans_without_guess = report.scans_without_guess;
   result.fixes = report.fixes;
+  result.speed_scale = report.speed_scale;
+  result.speed_scale_distance = report.speed_scale_distance;
 }
 
 }  // namespace

@@ -55,7 +55,10 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
     }
     inputs["file"] = "input_error.csv";
   }
-  if (ndt_used) j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(ndt, map, scans_without_guess));
+  if (ndt_used) {
+    j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(ndt, map, scans_without_guess));
+    j["odometry_speed_scale"] = {{"scale", speed_scale}, {"compared_m", speed_scale_distance}};
+  }
   if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes));
   j["rejections_first"] = rejections;
   return j.dump(2) + "\n";

@@ -116,11 +116,18 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
   if (route["speed"]) s.speed.cruise = r.positive(route["speed"], "route.speed");
   if (route["acceleration"]) s.speed.acceleration = r.positive(route["acceleration"], "route.acceleration");
   if (root["vehicle"]) {
-    r.keys(root["vehicle"], "vehicle", {"lidar", "lidar_height"});
+    r.keys(root["vehicle"], "vehicle", {"lidar", "lidar_height", "odometry"});
     if (root["vehicle"]["lidar"]) s.vehicle_lidar = r.text(root["vehicle"]["lidar"], "vehicle.lidar");
     if (s.vehicle_lidar != "VLP-16" && s.vehicle_lidar != "VLP-32C")
       r.fail(root["vehicle"]["lidar"], "vehicle.lidar", "unknown LiDAR model '" + s.vehicle_lidar + "' (VLP-16, VLP-32C)");
     if (root["vehicle"]["lidar_height"]) s.vehicle_lidar_height = r.positive(root["vehicle"]["lidar_height"], "vehicle.lidar_height");
+    if (const YAML::Node o = root["vehicle"]["odometry"]) {
+      r.keys(o, "vehicle.odometry", {"speed_sigma", "speed_scale", "yaw_rate_sigma", "yaw_rate_bias"});
+      if (o["speed_sigma"]) s.odometry.speed_sigma = r.inRange(o["speed_sigma"], "vehicle.odometry.speed_sigma", 0.0, 10.0);
+      if (o["speed_scale"]) s.odometry.speed_scale = r.inRange(o["speed_scale"], "vehicle.odometry.speed_scale", 0.5, 1.5);
+      if (o["yaw_rate_sigma"]) s.odometry.yaw_rate_sigma = r.inRange(o["yaw_rate_sigma"], "vehicle.odometry.yaw_rate_sigma", 0.0, 1.0);
+      if (o["yaw_rate_bias"]) s.odometry.yaw_rate_bias = r.inRange(o["yaw_rate_bias"], "vehicle.odometry.yaw_rate_bias", -1.0, 1.0);
+    }
   }
   if (root["rsus"]) {
     for (std::size_t i = 0; i < root["rsus"].size(); ++i) {

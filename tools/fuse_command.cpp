@@ -62,6 +62,7 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 (unsigned long long)n.max_iterations, (unsigned long long)n.oscillation, (unsigned long long)n.empty_scan,
                 (unsigned long long)n.no_map, (unsigned long long)r.scans_without_guess, n.scans ? n.align_ms_total / n.scans : 0.0,
                 r.map.builds);
+    std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
   }
   if (!r.errors.empty()) {
     const ErrorStats s = r.errorStats();

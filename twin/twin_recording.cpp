@@ -208,7 +208,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   std::map<std::string, PlotSeries> fix_errors;  // per RSU: error against distance
   std::map<std::pair<std::string, std::size_t>, std::pair<std::vector<double>, std::vector<double>>> variant_errors;
   const sim::LidarSpec roof = lidarNamed(scenario.vehicle_lidar);
-  const sim::OdometryNoise odometry_noise;
+  const sim::OdometryNoise& odometry_noise = scenario.odometry;
   const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
   for (int k = 0; k <= ticks; ++k) {  // 100 Hz
     const double t = k * 0.01;

@@ -68,6 +68,9 @@ struct PipelineSection {
   /// Starts the filter here (x, y, z [m], yaw [rad]) at the first input, for runs whose only pose
   /// source is NDT, which needs a first guess.
   std::optional<Eigen::Vector4d> initial_pose;
+  /// Learn the odometry's speed scale from NDT's poses and correct twists by it before the filter.
+  bool speed_scale_estimation = true;
+  double speed_scale_memory = 500.0;  ///< m of travel over which old comparisons fade
 };
 
 /// The live node's topics (ROS 2 names; DDS adds "rt") and QoS.

@@ -51,6 +51,8 @@ struct PipelineReport {
   std::uint64_t scans_without_map = 0;       ///< no map given
   std::uint64_t scans_superseded = 0;        ///< live: replaced by a newer scan while NDT was busy
   std::map<std::string, rsu_client::FixCounters> fixes;  ///< per RSU id
+  double speed_scale = 1.0;                  ///< true speed per odometry speed, as learned from NDT (1 until known)
+  double speed_scale_distance = 0.0;         ///< m of travel compared so far
   std::uint64_t rejections = 0;              ///< every refusal, of any kind
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };

@@ -51,6 +51,8 @@ struct ReplayResult {
   std::uint64_t scans_without_guess = 0;           ///< scans before the filter could predict their pose
   ndt::DynamicMapStats map;
   std::map<std::string, rsu_client::FixCounters> fixes;  ///< roadside fixes per RSU, when a registry was given
+  double speed_scale = 1.0;           ///< the odometry's speed scale learned from NDT
+  double speed_scale_distance = 0.0;  ///< m of travel it was learned over
 
   /// Everything that follows from the log and the config, as JSON (summary.json of `coloc fuse`): the
   /// same log and config give the same bytes. `log` is the name to print for the recording.

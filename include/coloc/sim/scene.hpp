@@ -37,6 +37,7 @@ struct Scenario {
   SpeedProfile speed;
   std::string vehicle_lidar = "VLP-32C";
   double vehicle_lidar_height = 1.9;  ///< m above the road
+  OdometryNoise odometry;             ///< the wheel odometry's noise, scale error and yaw-rate bias
   std::vector<ScenarioRsu> rsus;
 
   /// The meshes of the world (ground first) or of the world as surveyed.

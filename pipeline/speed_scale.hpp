@@ -1,0 +1,54 @@
+#pragma once
+// Online calibration of the odometry's speed scale against NDT. Wheel odometry reads speed through a
+// wheel radius that is never exact (tyre pressure, wear, load: 0.5-2 %), and the filter trusts it as
+// unbiased: a 1 % scale error at 10 m/s puts the estimate 10-30 cm ahead of NDT's own poses. Autoware
+// takes the factor as a fixed parameter (vehicle_velocity_converter's speed_scale_factor); here it is
+// measured as the ratio of the distance NDT's poses travel to the distance the odometry integrates,
+// over chords of a few metres, with exponential forgetting so that it follows slow changes.
+#include <deque>
+#include <optional>
+
+#include "coloc/core/time.hpp"
+#include "coloc/core/types.hpp"
+
+namespace coloc::pipeline {
+
+struct SpeedScaleConfig {
+  bool enabled = true;
+  double chord = 5.0;          ///< m of odometry travel between the two poses of one comparison
+  double memory = 500.0;       ///< m of travel over which old comparisons fade to 1/e
+  double min_distance = 15.0;  ///< m of odometry travel before the estimate is used
+  double max_error = 0.1;      ///< a scale further than this from 1 is refused (counted)
+};
+
+class SpeedScaleEstimator {
+ public:
+  explicit SpeedScaleEstimator(SpeedScaleConfig config = {}) : config_(config) {}
+
+  /// A twist as measured: integrates the distance the odometry claims.
+  void addTwist(Stamp stamp, double vx);
+  /// A pose of the anchoring source (NDT) that the filter accepted.
+  void addPose(Stamp stamp, const Eigen::Vector2d& position);
+  /// True speed per measured speed; 1 until enough travel was compared.
+  double scale() const { return usable() ? estimate_ : 1.0; }
+  bool usable() const { return config_.enabled && compared_ >= config_.min_distance; }
+  double comparedDistance() const { return compared_; }
+
+ private:
+  double odometryAt(Stamp stamp) const;
+
+  SpeedScaleConfig config_;
+  // Integrated odometry distance at each recent twist (trapezoids between them), so that the distance
+  // at a pose's stamp, which lies a sweep and a match in the past, is interpolated, not extrapolated.
+  struct Mark {
+    Stamp stamp;
+    double vx, distance;
+  };
+  std::deque<Mark> marks_;
+  // The pose the current chord starts at.
+  std::optional<std::pair<Eigen::Vector2d, double>> anchor_;  ///< position, odometry distance there
+  double weighted_pose_ = 0.0, weighted_odometry_ = 0.0;       ///< forgetful sums of chord lengths
+  double estimate_ = 1.0, compared_ = 0.0;
+};
+
+}  // namespace coloc::pipeline

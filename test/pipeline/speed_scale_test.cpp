@@ -1,0 +1,55 @@
+#include "speed_scale.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace coloc::pipeline {
+namespace {
+
+constexpr Stamp kStart = 1'700'000'000'000'000'000LL;
+
+// A drive at `speed` along x: odometry at 50 Hz reading `scale` times the true speed with white noise,
+// and NDT poses at 10 Hz with 2 cm of noise, each matched 105 ms after its stamp (when it reaches the
+// estimator, the odometry has moved on).
+SpeedScaleEstimator drive(double speed, double odometry_scale, double seconds, double jump_at = -1.0) {
+  SpeedScaleEstimator estimator;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> odometry_noise(0.0, 0.05), pose_noise(0.0, 0.02);
+  for (int k = 0; k * 0.02 <= seconds; ++k) {
+    const double t = k * 0.02;
+    estimator.addTwist(kStart + static_cast<Stamp>(t * 1e9), speed * odometry_scale + odometry_noise(rng));
+    if (k % 5 == 0 && t >= 0.105) {
+      const double taken = t - 0.105;
+      Eigen::Vector2d p(speed * taken + pose_noise(rng), pose_noise(rng));
+      if (jump_at >= 0.0 && std::abs(taken - jump_at) < 0.01) p.x() += 3.0;  // one NDT result that slipped
+      estimator.addPose(kStart + static_cast<Stamp>(taken * 1e9), p);
+    }
+  }
+  return estimator;
+}
+
+TEST(SpeedScale, LearnsAWheelRadiusErrorOfOnePercentToATenthOfAPercent) {
+  const SpeedScaleEstimator e = drive(10.0, 1.01, 20.0);
+  ASSERT_TRUE(e.usable());
+  EXPECT_NEAR(e.scale(), 1.0 / 1.01, 0.001);
+}
+
+TEST(SpeedScale, AnExactOdometryStaysAtOne) {
+  EXPECT_NEAR(drive(10.0, 1.0, 20.0).scale(), 1.0, 0.001);
+  EXPECT_NEAR(drive(5.0, 1.0, 40.0).scale(), 1.0, 0.001);
+}
+
+TEST(SpeedScale, IsOneUntilEnoughTravelWasCompared) {
+  const SpeedScaleEstimator e = drive(10.0, 1.05, 1.0);  // 10 m: not yet the 15 m it needs
+  EXPECT_FALSE(e.usable());
+  EXPECT_EQ(e.scale(), 1.0);
+}
+
+TEST(SpeedScale, AnNdtJumpIsNotTakenForAScale) {
+  const SpeedScaleEstimator e = drive(10.0, 1.01, 20.0, 8.0);
+  EXPECT_NEAR(e.scale(), 1.0 / 1.01, 0.002);
+}
+
+}  // namespace
+}  // namespace coloc::pipeline
