@@ -167,18 +167,15 @@ void checkEncodableString(const std::string& text, const char* field, std::strin
 }
 
 std_msgs::msg::Header toRos(const Header& header, std::string_view type) {
-  // Floor division so that negative stamps keep nanosec in [0, 1e9) as ROS requires.
-  Stamp sec = header.stamp / kNanosPerSecond;
-  Stamp nanosec = header.stamp % kNanosPerSecond;
-  if (nanosec < 0) nanosec += kNanosPerSecond, sec -= 1;
-  if (sec < INT32_MIN || sec > INT32_MAX) {
+  const RosTime time = toRosTime(header.stamp);
+  if (!time.fits) {
     detail::throwCodecError(type, "header stamp " + formatSeconds(header.stamp) +
                                       " s does not fit builtin_interfaces/Time (int32 seconds)");
   }
   checkEncodableString(header.frame_id, "header.frame_id", type);
   std_msgs::msg::Header out;
-  out.stamp().sec(static_cast<std::int32_t>(sec));
-  out.stamp().nanosec(static_cast<std::uint32_t>(nanosec));
+  out.stamp().sec(time.sec);
+  out.stamp().nanosec(time.nanosec);
   out.frame_id(header.frame_id);
   return out;
 }
@@ -442,11 +439,10 @@ Bytes encodePointCloud2(const PointCloud2& message) {
 // ---- rosgraph_msgs/Clock: two 32-bit fields, written by hand ----
 
 Bytes encodeClock(Stamp time) {
-  const Stamp sec = time >= 0 ? time / kNanosPerSecond : (time - kNanosPerSecond + 1) / kNanosPerSecond;
-  if (sec > std::numeric_limits<std::int32_t>::max() || sec < std::numeric_limits<std::int32_t>::min())
-    throw Error("Clock: " + formatSeconds(time) + " s does not fit builtin_interfaces/Time (int32 seconds)");
-  const auto s32 = static_cast<std::int32_t>(sec);
-  const auto ns = static_cast<std::uint32_t>(time - sec * kNanosPerSecond);
+  const RosTime ros = toRosTime(time);
+  if (!ros.fits) throw Error("Clock: " + formatSeconds(time) + " s does not fit builtin_interfaces/Time (int32 seconds)");
+  const std::int32_t s32 = ros.sec;
+  const std::uint32_t ns = ros.nanosec;
   Bytes b = {0x00, 0x01, 0x00, 0x00};  // XCDR1, little endian
   for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(s32) >> (8 * i)));
   for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(ns >> (8 * i)));

@@ -50,9 +50,10 @@ dds::DataReaderQos readerQos(const DdsConfig& c) { return withConfig(dds::DATARE
 dds::DataWriterQos writerQos(const DdsConfig& c) { return withConfig(dds::DATAWRITER_QOS_DEFAULT, c); }
 
 void setStamp(std_msgs::msg::Header& header, Stamp stamp, const std::string& frame) {
-  const Stamp sec = stamp >= 0 ? stamp / kNanosPerSecond : (stamp - kNanosPerSecond + 1) / kNanosPerSecond;
-  header.stamp().sec(static_cast<std::int32_t>(sec));
-  header.stamp().nanosec(static_cast<std::uint32_t>(stamp - sec * kNanosPerSecond));
+  const RosTime time = toRosTime(stamp);
+  if (!time.fits) throw Error("DDS: stamp " + formatSeconds(stamp) + " s does not fit builtin_interfaces/Time (int32 seconds)");
+  header.stamp().sec(time.sec);
+  header.stamp().nanosec(time.nanosec);
   header.frame_id(frame);
 }
 

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "coloc/ndt/aligner.hpp"
+#include "coloc/ndt/ndt_pose_source.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/preprocess.hpp"
 #include "commands.hpp"
@@ -12,10 +13,17 @@ namespace coloc::tools {
 
 void addAlignCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("align", "Align SOURCE to TARGET (PCD files) with NDT and print the result as JSON");
-  static std::string target_path, source_path, backend = "fast", neighborhood = "radius", covariance = "fixed";
+  // Defaults are ndt's own (ndt::NdtConfig), so that `coloc align` and the pipeline match alike.
+  static const ndt::NdtConfig d;
+  static std::string target_path, source_path, backend = d.backend == ndt::NdtBackend::kPcl ? "pcl" : "fast",
+                                               neighborhood = d.neighborhood == ndt::Neighborhood::kRadius  ? "radius"
+                                                              : d.neighborhood == ndt::Neighborhood::kFace7 ? "face7"
+                                                                                                            : "single",
+                                               covariance = d.covariance == ndt::CovarianceMode::kFixed ? "fixed" : "laplace";
   static std::vector<double> init;
-  static double resolution = 2.0, step = 0.1, epsilon = 1e-4, source_voxel = 0.1, nvtl_threshold = 2.3;
-  static int iterations = 30, threads = 0;
+  static double resolution = d.resolution, step = d.step_size, epsilon = d.transformation_epsilon, source_voxel = 0.1,
+                nvtl_threshold = d.nvtl_threshold;
+  static int iterations = d.max_iterations, threads = d.threads;
   cmd->add_option("TARGET", target_path, "map / target cloud (.pcd)")->required()->check(CLI::ExistingFile);
   cmd->add_option("SOURCE", source_path, "scan / source cloud (.pcd)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--init", init, "initial guess x y z yaw (m, m, m, rad)")->expected(4);
@@ -42,6 +50,9 @@ void addAlignCommand(CLI::App& app) {
     config.nvtl_threshold = nvtl_threshold;
     config.covariance = covariance == "laplace" ? ndt::CovarianceMode::kLaplace : ndt::CovarianceMode::kFixed;
     config.threads = threads;
+    ndt::NdtPoseSourceConfig check;
+    check.ndt = config;
+    ndt::validate(check);  // the same ranges, the same words as the config file
     const ndt::PointCloud target_cloud = ndt::loadPcd(target_path);
     const ndt::PointCloud source_cloud = ndt::voxelDownsample(ndt::loadPcd(source_path), source_voxel);
     const ndt::NdtTarget target(target_cloud, config);
