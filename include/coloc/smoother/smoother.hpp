@@ -1,0 +1,97 @@
+#pragma once
+// A batch smoother over the filter's inputs: every measurement is used for every pose. States sit at
+// the filter's tick rate with the filter's motion model (x, y, yaw, yaw bias, vx, wz) as motion
+// residuals weighted by its process noise; poses are residuals with their full covariance on the
+// components they measure (an infinite variance leaves its component out exactly), each at its own
+// stamp by propagating the state before it; twists likewise. A robust loss whose scale is the filter's
+// gate replaces hard gates, and what it down-weighted is reported. Ceres solves it; its summary and the
+// marginal covariances of the positions come back with the states. Depends on core and Ceres only.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "coloc/core/types.hpp"
+
+namespace coloc::smoother {
+
+struct SmootherOptions {
+  double rate = 50.0;              ///< Hz, the states' spacing (the filter's predict_frequency)
+  // The filter's process noise, per second (Autoware's defaults, as fusion.proc_stddev_*).
+  double proc_stddev_yaw_c = 0.005;  ///< rad/s
+  double proc_stddev_vx_c = 10.0;    ///< m/s^2
+  double proc_stddev_wz_c = 5.0;     ///< rad/s^2
+  /// The filter's model moves x, y and the yaw bias without noise; a batch problem needs a finite
+  /// weight, so they get this much (small: the motion model's own error, not a source of freedom).
+  double proc_stddev_position_c = 0.02;  ///< m/s
+  double proc_stddev_yaw_bias_c = 1e-4;  ///< rad/s
+  double initial_yaw_bias_variance = 1e-4;  ///< rad^2, a prior pulling the bias to 0 (as the filter starts)
+  /// Chance that a correct measurement is down-weighted: the Huber loss starts at the square root of
+  /// the chi-square (1 - alpha) quantile of its dimension, where the filter's gate refuses.
+  double gate_alpha = 1e-10;
+  bool robust = true;
+  int max_iterations = 50;
+  int threads = 2;
+  bool covariances = true;  ///< marginal covariance of every state's position
+};
+
+/// A measurement the robust loss weighed less than its covariance says.
+struct DownWeighted {
+  std::string source;
+  Stamp stamp = 0;
+  double mahalanobis = 0.0;  ///< sqrt of the whitened squared residual at the solution
+  double weight = 1.0;       ///< the loss's weight there (1 = full)
+};
+
+struct SmootherSummary {
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+  double seconds = 0.0;
+  std::string termination;   ///< Ceres' CONVERGENCE, NO_CONVERGENCE, FAILURE...
+  std::string report;        ///< Ceres' BriefReport
+  int states = 0, pose_residuals = 0, twist_residuals = 0;
+  std::vector<DownWeighted> down_weighted;
+  bool usable() const { return termination == "CONVERGENCE" || termination == "NO_CONVERGENCE"; }
+};
+
+struct SmoothedState {
+  Stamp stamp = 0;
+  Vector6d state = Vector6d::Zero();  ///< [x, y, yaw, yaw_bias, vx, wz]
+  std::optional<Eigen::Matrix2d> position_covariance;
+};
+
+struct SmootherResult {
+  std::vector<SmoothedState> states;
+  SmootherSummary summary;
+};
+
+class Smoother {
+ public:
+  explicit Smoother(SmootherOptions options = {});
+  ~Smoother();
+  Smoother(Smoother&&) noexcept;
+  Smoother& operator=(Smoother&&) noexcept;
+
+  /// A pose measurement; x, y and yaw enter where their variance is finite (z, roll and pitch are not
+  /// in the planar state). Returns false, leaving the problem unchanged, for a measurement with no
+  /// finite x, y or yaw variance or a covariance that is not positive definite on them.
+  bool addPose(const std::string& source, const PoseMeasurement& measurement);
+  /// A twist; vx and wz enter where their variance is finite.
+  bool addTwist(const std::string& source, const TwistMeasurement& measurement);
+  /// A first guess of the state at a stamp (the filter's estimates, say); states between guesses are
+  /// interpolated, and the first guess also anchors a weak prior on the yaw bias.
+  void addGuess(Stamp stamp, const Vector6d& state);
+
+  /// Solves for states every 1/rate from `first` to `last`. Throws coloc::Error when there are no
+  /// guesses to start from or the span is empty.
+  SmootherResult solve(Stamp first, Stamp last) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The chi-square quantile for `dof` degrees of freedom (1-3) at probability 1 - alpha.
+double chiSquareQuantile(int dof, double alpha);
+
+}  // namespace coloc::smoother

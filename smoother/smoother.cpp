@@ -1,0 +1,350 @@
+#include "coloc/smoother/smoother.hpp"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "coloc/core/error.hpp"
+
+namespace coloc::smoother {
+
+namespace {
+
+// The filter's motion model, written once for doubles and Ceres' Jets: constant speed and yaw rate,
+// moving along yaw + yaw bias.
+template <typename T>
+void propagate(const T* s, double dt, T* out) {
+  using std::cos;
+  using std::sin;
+  const T heading = s[2] + s[3];
+  out[0] = s[0] + s[4] * cos(heading) * dt;
+  out[1] = s[1] + s[4] * sin(heading) * dt;
+  out[2] = s[2] + s[5] * dt;
+  out[3] = s[3];
+  out[4] = s[4];
+  out[5] = s[5];
+}
+
+template <typename T>
+T wrapped(const T& angle) {
+  using std::atan2;
+  using std::cos;
+  using std::sin;
+  return atan2(sin(angle), cos(angle));
+}
+
+struct MotionResidual {
+  double dt;
+  Vector6d inverse_sigma;
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    T predicted[6];
+    propagate(a, dt, predicted);
+    for (int i = 0; i < 6; ++i) {
+      T d = b[i] - predicted[i];
+      if (i == 2) d = wrapped(d);
+      r[i] = d * inverse_sigma[i];
+    }
+    return true;
+  }
+};
+
+// A measurement of some of (x, y, yaw) at `dt` after the state it hangs on.
+struct PoseResidual {
+  double dt;
+  int m;
+  int component[3];  ///< state index of each measured component: 0 x, 1 y, 2 yaw
+  double value[3];
+  Eigen::Matrix3d whitening;  ///< L^-1 of the measured block's covariance (upper-left m x m)
+  template <typename T>
+  bool operator()(const T* s, T* r) const {
+    T p[6];
+    propagate(s, dt, p);
+    T e[3];
+    for (int j = 0; j < m; ++j) {
+      e[j] = p[component[j]] - value[j];
+      if (component[j] == 2) e[j] = wrapped(e[j]);
+    }
+    for (int i = 0; i < m; ++i) {
+      r[i] = T(0.0);
+      for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
+    }
+    return true;
+  }
+};
+
+// A measurement of vx and/or wz at a fraction `w` of the way from one state to the next.
+struct TwistResidual {
+  double w;
+  int m;
+  int component[2];  ///< 4 vx, 5 wz
+  double value[2];
+  Eigen::Matrix2d whitening;
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    T e[2];
+    for (int j = 0; j < m; ++j) e[j] = (1.0 - w) * a[component[j]] + w * b[component[j]] - value[j];
+    for (int i = 0; i < m; ++i) {
+      r[i] = T(0.0);
+      for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
+    }
+    return true;
+  }
+};
+
+struct YawBiasPrior {
+  double inverse_sigma;
+  template <typename T>
+  bool operator()(const T* s, T* r) const {
+    r[0] = s[3] * inverse_sigma;
+    return true;
+  }
+};
+
+struct StoredPose {
+  std::string source;
+  Stamp stamp;
+  int m;
+  int component[3];
+  double value[3];
+  Eigen::Matrix3d whitening;
+};
+
+struct StoredTwist {
+  std::string source;
+  Stamp stamp;
+  int m;
+  int component[2];
+  double value[2];
+  Eigen::Matrix2d whitening;
+};
+
+const char* terminationName(ceres::TerminationType t) {
+  switch (t) {
+    case ceres::CONVERGENCE: return "CONVERGENCE";
+    case ceres::NO_CONVERGENCE: return "NO_CONVERGENCE";
+    case ceres::FAILURE: return "FAILURE";
+    case ceres::USER_SUCCESS: return "USER_SUCCESS";
+    case ceres::USER_FAILURE: return "USER_FAILURE";
+  }
+  return "?";
+}
+
+double chiSquareSurvival(int dof, double x) {
+  const double h = std::sqrt(0.5 * x);
+  switch (dof) {
+    case 1: return std::erfc(h);
+    case 2: return std::exp(-0.5 * x);
+    default: return std::erfc(h) + std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
+  }
+}
+
+}  // namespace
+
+double chiSquareQuantile(int dof, double alpha) {
+  if (dof < 1 || dof > 3) throw Error("chiSquareQuantile: dof must be 1, 2 or 3");
+  if (!(alpha > 0.0 && alpha < 1.0)) throw Error("chiSquareQuantile: alpha must be in (0, 1)");
+  double lo = 0.0, hi = 1000.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (chiSquareSurvival(dof, mid) > alpha ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+struct Smoother::Impl {
+  SmootherOptions options;
+  std::vector<StoredPose> poses;
+  std::vector<StoredTwist> twists;
+  std::map<Stamp, Vector6d> guesses;
+
+  // The guess at a stamp: linear between the neighbouring guesses (yaw along the short way round).
+  Vector6d guessAt(Stamp t) const {
+    auto after = guesses.lower_bound(t);
+    if (after == guesses.end()) return std::prev(after)->second;
+    if (after == guesses.begin() || after->first == t) return after->second;
+    const auto before = std::prev(after);
+    const double w = static_cast<double>(t - before->first) / static_cast<double>(after->first - before->first);
+    Vector6d g = (1.0 - w) * before->second + w * after->second;
+    g[2] = wrapAngle(before->second[2] + w * wrapAngle(after->second[2] - before->second[2]));
+    return g;
+  }
+};
+
+Smoother::Smoother(SmootherOptions options) : impl_(std::make_unique<Impl>()) { impl_->options = options; }
+Smoother::~Smoother() = default;
+Smoother::Smoother(Smoother&&) noexcept = default;
+Smoother& Smoother::operator=(Smoother&&) noexcept = default;
+
+bool Smoother::addPose(const std::string& source, const PoseMeasurement& measurement) {
+  StoredPose p;
+  p.source = source;
+  p.stamp = measurement.stamp;
+  p.m = 0;
+  const double yaw = rollPitchYaw(measurement.pose.orientation)[2];
+  const int covariance_index[3] = {0, 1, 5};  // x, y, yaw in the ROS 6x6 order
+  const double values[3] = {measurement.pose.position.x(), measurement.pose.position.y(), yaw};
+  int used[3];
+  for (int k = 0; k < 3; ++k) {
+    const double v = measurement.covariance(covariance_index[k], covariance_index[k]);
+    if (std::isfinite(v) && v > 0.0 && std::isfinite(values[k])) {
+      used[p.m] = covariance_index[k];
+      p.component[p.m] = k;
+      p.value[p.m] = values[k];
+      ++p.m;
+    }
+  }
+  if (p.m == 0) return false;
+  Eigen::Matrix3d block = Eigen::Matrix3d::Identity();
+  for (int i = 0; i < p.m; ++i)
+    for (int j = 0; j < p.m; ++j) block(i, j) = measurement.covariance(used[i], used[j]);
+  const Eigen::LLT<Eigen::MatrixXd> llt(block.topLeftCorner(p.m, p.m));
+  if (llt.info() != Eigen::Success || !block.topLeftCorner(p.m, p.m).allFinite()) return false;
+  p.whitening = Eigen::Matrix3d::Zero();
+  p.whitening.topLeftCorner(p.m, p.m) = llt.matrixL().solve(Eigen::MatrixXd::Identity(p.m, p.m));
+  impl_->poses.push_back(p);
+  return true;
+}
+
+bool Smoother::addTwist(const std::string& source, const TwistMeasurement& measurement) {
+  StoredTwist t;
+  t.source = source;
+  t.stamp = measurement.stamp;
+  t.m = 0;
+  const int covariance_index[2] = {0, 5};
+  const double values[2] = {measurement.linear.x(), measurement.angular.z()};
+  int used[2];
+  for (int k = 0; k < 2; ++k) {
+    const double v = measurement.covariance(covariance_index[k], covariance_index[k]);
+    if (std::isfinite(v) && v > 0.0 && std::isfinite(values[k])) {
+      used[t.m] = covariance_index[k];
+      t.component[t.m] = k == 0 ? 4 : 5;
+      t.value[t.m] = values[k];
+      ++t.m;
+    }
+  }
+  if (t.m == 0) return false;
+  Eigen::Matrix2d block = Eigen::Matrix2d::Identity();
+  for (int i = 0; i < t.m; ++i)
+    for (int j = 0; j < t.m; ++j) block(i, j) = measurement.covariance(used[i], used[j]);
+  const Eigen::LLT<Eigen::MatrixXd> llt(block.topLeftCorner(t.m, t.m));
+  if (llt.info() != Eigen::Success || !block.topLeftCorner(t.m, t.m).allFinite()) return false;
+  t.whitening = Eigen::Matrix2d::Zero();
+  t.whitening.topLeftCorner(t.m, t.m) = llt.matrixL().solve(Eigen::MatrixXd::Identity(t.m, t.m));
+  impl_->twists.push_back(t);
+  return true;
+}
+
+void Smoother::addGuess(Stamp stamp, const Vector6d& state) {
+  if (state.allFinite()) impl_->guesses[stamp] = state;
+}
+
+SmootherResult Smoother::solve(Stamp first, Stamp last) const {
+  const SmootherOptions& o = impl_->options;
+  if (impl_->guesses.empty()) throw Error("smoother: no first guess of the states (addGuess)");
+  if (last <= first) throw Error("smoother: the span to smooth is empty");
+  const Duration step = static_cast<Duration>(std::llround(1e9 / o.rate));
+  const std::size_t n = static_cast<std::size_t>((last - first) / step) + 1;
+  SmootherResult result;
+  result.states.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    result.states[k].stamp = first + static_cast<Stamp>(k) * step;
+    result.states[k].state = impl_->guessAt(result.states[k].stamp);
+  }
+  auto blockOf = [&](std::size_t k) { return result.states[k].state.data(); };
+
+  ceres::Problem problem;
+  const double dt = toSeconds(step);
+  Vector6d inverse_sigma;
+  inverse_sigma << 1.0 / (o.proc_stddev_position_c * dt), 1.0 / (o.proc_stddev_position_c * dt), 1.0 / (o.proc_stddev_yaw_c * dt),
+      1.0 / (o.proc_stddev_yaw_bias_c * dt), 1.0 / (o.proc_stddev_vx_c * dt), 1.0 / (o.proc_stddev_wz_c * dt);
+  for (std::size_t k = 0; k + 1 < n; ++k)
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<MotionResidual, 6, 6, 6>(new MotionResidual{dt, inverse_sigma}), nullptr,
+                             blockOf(k), blockOf(k + 1));
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YawBiasPrior, 1, 6>(new YawBiasPrior{1.0 / std::sqrt(o.initial_yaw_bias_variance)}),
+                           nullptr, blockOf(0));
+
+  struct Added {
+    ceres::ResidualBlockId id;
+    const std::string* source;
+    Stamp stamp;
+    double threshold;  ///< squared whitened norm where the loss starts to down-weight
+  };
+  std::vector<Added> added;
+  auto loss = [&](int m) -> std::pair<ceres::LossFunction*, double> {
+    const double delta2 = chiSquareQuantile(m, o.gate_alpha);
+    return {o.robust ? new ceres::HuberLoss(std::sqrt(delta2)) : nullptr, delta2};
+  };
+  for (const StoredPose& p : impl_->poses) {
+    if (p.stamp < first || p.stamp > last) continue;
+    const std::size_t k = std::min(n - 1, static_cast<std::size_t>((p.stamp - first) / step));
+    PoseResidual* r = new PoseResidual{toSeconds(p.stamp - result.states[k].stamp), p.m, {}, {}, p.whitening};
+    for (int j = 0; j < p.m; ++j) r->component[j] = p.component[j], r->value[j] = p.value[j];
+    const auto [l, delta2] = loss(p.m);
+    added.push_back({problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PoseResidual, ceres::DYNAMIC, 6>(r, p.m), l, blockOf(k)),
+                     &p.source, p.stamp, delta2});
+    ++result.summary.pose_residuals;
+  }
+  for (const StoredTwist& t : impl_->twists) {
+    if (t.stamp < first || t.stamp > last || n < 2) continue;
+    const std::size_t k = std::min(n - 2, static_cast<std::size_t>((t.stamp - first) / step));
+    TwistResidual* r = new TwistResidual{toSeconds(t.stamp - result.states[k].stamp) / dt, t.m, {}, {}, t.whitening};
+    for (int j = 0; j < t.m; ++j) r->component[j] = t.component[j], r->value[j] = t.value[j];
+    const auto [l, delta2] = loss(t.m);
+    added.push_back(
+        {problem.AddResidualBlock(new ceres::AutoDiffCostFunction<TwistResidual, ceres::DYNAMIC, 6, 6>(r, t.m), l, blockOf(k), blockOf(k + 1)),
+         &t.source, t.stamp, delta2});
+    ++result.summary.twist_residuals;
+  }
+
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = o.max_iterations;
+  solver.num_threads = std::max(1, o.threads);
+  solver.minimizer_progress_to_stdout = false;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  const auto start = std::chrono::steady_clock::now();
+  ceres::Solve(solver, &problem, &summary);
+  result.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.summary.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.summary.initial_cost = summary.initial_cost;
+  result.summary.final_cost = summary.final_cost;
+  result.summary.termination = terminationName(summary.termination_type);
+  result.summary.report = summary.BriefReport();
+  result.summary.states = static_cast<int>(n);
+  for (SmoothedState& s : result.states) s.state[2] = wrapAngle(s.state[2]);
+
+  // What the robust loss weighed less than its covariance: whitened norms beyond the gate.
+  for (const Added& a : added) {
+    const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(a.id);
+    std::vector<double*> parameters;
+    problem.GetParameterBlocksForResidualBlock(a.id, &parameters);
+    std::vector<double> residuals(static_cast<std::size_t>(f->num_residuals()));
+    f->Evaluate(parameters.data(), residuals.data(), nullptr);
+    double s = 0.0;
+    for (double r : residuals) s += r * r;
+    if (s > a.threshold) result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(s), std::sqrt(a.threshold / s)});
+  }
+
+  if (o.covariances && result.summary.usable()) {
+    ceres::Covariance::Options co;
+    co.num_threads = std::max(1, o.threads);
+    co.algorithm_type = ceres::SPARSE_QR;
+    ceres::Covariance covariance(co);
+    std::vector<std::pair<const double*, const double*>> blocks;
+    blocks.reserve(n);
+    for (std::size_t k = 0; k < n; ++k) blocks.emplace_back(blockOf(k), blockOf(k));
+    if (covariance.Compute(blocks, &problem)) {
+      double c[36];
+      for (std::size_t k = 0; k < n; ++k)
+        if (covariance.GetCovarianceBlock(blockOf(k), blockOf(k), c)) result.states[k].position_covariance = Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(c).topLeftCorner<2, 2>();
+    }
+  }
+  return result;
+}
+
+}  // namespace coloc::smoother
