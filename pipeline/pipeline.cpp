@@ -154,6 +154,7 @@ struct Pipeline::Impl {
   PipelineReport report;
   std::function<void(const fusion::Estimate&)> on_estimate;
   std::function<void(const std::string&, const PoseMeasurement&)> on_pose_input;
+  std::function<void(const std::string&, const TwistMeasurement&)> on_twist_input;
   std::function<void(const std::string&)> on_rejection;
 
   mutable std::mutex estimate_mutex;
@@ -273,6 +274,7 @@ struct Pipeline::Impl {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
       }
+      if (on_twist_input) on_twist_input(source_names[twist->source], t);
       localizer.feedTwist(twist->source, t);
     } else if (auto* pose = std::get_if<PoseInput>(&input)) {
       feedPose(pose->source, pose->pose);
@@ -356,6 +358,10 @@ void Pipeline::onEstimate(std::function<void(const fusion::Estimate&)> callback)
 void Pipeline::onPoseInput(std::function<void(const std::string&, const PoseMeasurement&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_pose_input = std::move(callback);
+}
+void Pipeline::onTwistInput(std::function<void(const std::string&, const TwistMeasurement&)> callback) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  impl_->on_twist_input = std::move(callback);
 }
 void Pipeline::onRejection(std::function<void(const std::string&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->state_mutex);

@@ -171,11 +171,17 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
     if (result.topics[i].role == InputRole::kPose) source_of[i] = pipe.addPoseSource(result.topics[i].source);
     if (result.topics[i].role == InputRole::kTwist) source_of[i] = pipe.addTwistSource(result.topics[i].source);
   }
-  pipe.onEstimate([&](const fusion::Estimate& e) { result.fused.push_back({e.stamp, e.pose}); });
+  const bool keep = options.keep_filter_inputs;
+  pipe.onEstimate([&](const fusion::Estimate& e) {
+    result.fused.push_back({e.stamp, e.pose});
+    if (keep) result.fused_states.emplace_back(e.stamp, e.state);
+  });
   pipe.onPoseInput([&](const std::string& source, const PoseMeasurement& p) {
     result.pose_inputs.push_back({p.stamp, p.pose});
     result.pose_input_sources.push_back(source);
+    if (keep) result.filter_poses.emplace_back(source, p);
   });
+  if (keep) pipe.onTwistInput([&](const std::string& source, const TwistMeasurement& t) { result.filter_twists.emplace_back(source, t); });
   pipe.onRejection([&](const std::string& line) {
     if (result.rejections.size() < 20) result.rejections.push_back(line);
   });

@@ -14,5 +14,6 @@ void addSimulateCommand(CLI::App& app);
 void addExperimentCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);
 void addPlayCommand(CLI::App& app);
+void addSmoothCommand(CLI::App& app);
 
 }  // namespace coloc::tools

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   coloc::tools::addExperimentCommand(app);
   coloc::tools::addLocalizeCommand(app);
   coloc::tools::addPlayCommand(app);
+  coloc::tools::addSmoothCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -16,6 +16,13 @@ grep -q '/rsu/rsu_a/fix .* rsu_fix' "$work/fuse.txt" || { echo "FAIL: no RSU fix
 grep -q 'RSU rsu_a: [1-9][0-9]* fixes received, [1-9][0-9]* accepted' "$work/fuse.txt" || { echo "FAIL: the fixes did not pass the registry's checks"; exit 1; }
 grep -q 'NDT: [0-9]* scans -> [1-9]' "$work/fuse.txt" || { echo "FAIL: NDT produced no pose"; exit 1; }
 grep -q 'position error vs ground truth' "$work/fuse.txt" || { echo "FAIL: no error against ground truth"; exit 1; }
-mean=$(sed -n 's/.*mean \([0-9.]*\) m, RMSE.*/\1/p' "$work/fuse.txt")
+mean=$(sed -n '/position error vs ground truth/ s/.*mean \([0-9.]*\) m, RMSE.*/\1/p' "$work/fuse.txt")
 awk -v m="$mean" 'BEGIN { exit !(m < 1.0) }' || { echo "FAIL: mean error $mean m"; exit 1; }
 echo "simulated twice identically and fused: mean error $mean m"
+
+# The same log smoothed: every measurement at once must beat the causal filter clearly.
+"$coloc" smooth "$work/a/log" --map "$work/a/map" --config "$work/a/fuse.yaml" --out "$work/smoothed" | tee "$work/smooth.txt"
+grep -q 'Termination: CONVERGENCE' "$work/smooth.txt" || { echo "FAIL: the smoother did not converge"; exit 1; }
+read -r filter smoothed < <(sed -n 's/.*filter mean \([0-9.]*\) m .*smoother mean \([0-9.]*\) m .*/\1 \2/p' "$work/smooth.txt")
+awk -v f="$filter" -v s="$smoothed" 'BEGIN { exit !(s <= 0.8 * f) }' || { echo "FAIL: smoother $smoothed m against filter $filter m"; exit 1; }
+echo "smoothed: $smoothed m against the filter's $filter m"

@@ -51,6 +51,11 @@ struct ReplayResult {
   std::uint64_t scans_without_guess = 0;           ///< scans before the filter could predict their pose
   ndt::DynamicMapStats map;
   std::map<std::string, rsu_client::FixCounters> fixes;  ///< roadside fixes per RSU, when a registry was given
+  /// With ReplayOptions::keep_filter_inputs: every pose and twist as the filter got them (after NDT,
+  /// the fix checks and the speed scale), and the filter's state at every tick, for a smoother.
+  std::vector<std::pair<std::string, PoseMeasurement>> filter_poses;
+  std::vector<std::pair<std::string, TwistMeasurement>> filter_twists;
+  std::vector<std::pair<Stamp, Vector6d>> fused_states;
   double speed_scale = 1.0;           ///< the odometry's speed scale learned from NDT
   double speed_scale_distance = 0.0;  ///< m of travel it was learned over
 
@@ -70,6 +75,7 @@ struct ReplayOptions {
   /// The RSUs whose fixes are trusted; unset: the one config.rsu.registry names, if any.
   std::optional<rsu_client::RsuRegistry> registry;
   std::function<void(double fraction)> progress;  ///< called now and then with 0..1
+  bool keep_filter_inputs = false;  ///< fill filter_poses, filter_twists and fused_states
 };
 
 /// Throws coloc::Error if the log cannot be read at all; bad messages inside it are counted, not fatal.

@@ -1,0 +1,41 @@
+#pragma once
+// A recorded log smoothed: replayed through the vehicle pipeline first (NDT from the filter's
+// prediction, the fix checks, the speed scale: the smoother gets exactly what the filter got, and
+// the filter's states as its first guess), then every pose and twist solved for at once by the Ceres
+// smoother, and both trajectories scored against the log's ground truth.
+#include <string>
+#include <vector>
+
+#include "coloc/replay/log_replay.hpp"
+#include "coloc/smoother/smoother.hpp"
+
+namespace coloc::replay {
+
+struct SmoothOptions {
+  ReplayOptions replay;
+  /// The smoother's settings; rate, process noise and the robust loss's alpha follow the filter's
+  /// configuration (replay.config.fusion) unless changed after `smootherOptionsFor`.
+  smoother::SmootherOptions smoother;
+};
+
+/// The smoother's settings that match a filter configuration: tick rate, process noise, yaw-bias
+/// prior and the gate's alpha (0, no gate, turns the robust loss off).
+smoother::SmootherOptions smootherOptionsFor(const fusion::EkfConfig& filter);
+
+struct SmoothResult {
+  ReplayResult filter;                         ///< the replay, with the filter's own errors
+  std::vector<io::TrajectoryPoint> smoothed;   ///< every state
+  std::vector<smoother::SmoothedState> states;
+  std::vector<ErrorSample> errors;             ///< the smoothed pose against ground truth
+  smoother::SmootherSummary summary;
+  double wall_seconds = 0.0;                   ///< the smoothing alone
+
+  /// summary.json of `coloc smooth`: position_error as `coloc fuse` reports it, the filter's beside it,
+  /// the solver's summary and what the robust loss down-weighted.
+  std::string summaryJson(const std::string& log) const;
+};
+
+/// Throws coloc::Error if the log cannot be read or holds nothing to smooth.
+SmoothResult smoothLog(const std::string& log_path, SmoothOptions options);
+
+}  // namespace coloc::replay

@@ -1,0 +1,80 @@
+#include "coloc/replay/log_smoother.hpp"
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "coloc/core/error.hpp"
+
+namespace coloc::replay {
+
+smoother::SmootherOptions smootherOptionsFor(const fusion::EkfConfig& filter) {
+  smoother::SmootherOptions o;
+  o.rate = filter.predict_frequency;
+  o.proc_stddev_yaw_c = filter.proc_stddev_yaw_c;
+  o.proc_stddev_vx_c = filter.proc_stddev_vx_c;
+  o.proc_stddev_wz_c = filter.proc_stddev_wz_c;
+  o.initial_yaw_bias_variance = filter.initial_yaw_bias_variance;
+  o.robust = filter.pose_gate_alpha > 0.0;
+  if (o.robust) o.gate_alpha = filter.pose_gate_alpha;
+  return o;
+}
+
+SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
+  options.replay.keep_filter_inputs = true;
+  SmoothResult result;
+  result.filter = replayLog(log_path, options.replay);
+  const ReplayResult& f = result.filter;
+  if (f.fused_states.size() < 2) throw Error(log_path + ": the filter gave fewer than two estimates: nothing to smooth");
+  const auto start = std::chrono::steady_clock::now();
+  smoother::Smoother s(options.smoother);
+  for (const auto& [stamp, state] : f.fused_states) s.addGuess(stamp, state);
+  for (const auto& [source, pose] : f.filter_poses) s.addPose(source, pose);
+  for (const auto& [source, twist] : f.filter_twists) s.addTwist(source, twist);
+  const smoother::SmootherResult r = s.solve(f.fused_states.front().first, f.fused_states.back().first);
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.summary = r.summary;
+  result.states = r.states;
+  for (const smoother::SmoothedState& st : r.states) {
+    io::TrajectoryPoint p;
+    p.stamp = st.stamp;
+    p.pose.position = {st.state[0], st.state[1], 0.0};
+    p.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, st.state[2] + st.state[3]);  // heading, as the filter gives it
+    result.smoothed.push_back(p);
+  }
+  result.errors = evaluate(result.smoothed, f.ground_truth, fromSeconds(options.replay.config.replay.ground_truth_max_gap));
+  return result;
+}
+
+namespace {
+
+nlohmann::ordered_json errorJson(const std::vector<ErrorSample>& errors, const char* file) {
+  if (errors.empty()) return nullptr;
+  const ErrorStats s = errorStats(errors);
+  return {{"samples", errors.size()}, {"mean_m", s.mean},   {"rmse_m", s.rmse},
+          {"max_m", s.max},           {"along_mean_m", s.along_mean}, {"across_mean_m", s.across_mean},
+          {"file", file}};
+}
+
+}  // namespace
+
+std::string SmoothResult::summaryJson(const std::string& log) const {
+  nlohmann::ordered_json j;
+  j["log"] = log;
+  j["smoothed"] = {{"file", "smoothed.tum"}, {"states", smoothed.size()}};
+  j["position_error"] = errorJson(errors, "error.csv");
+  j["filter_position_error"] = errorJson(filter.errors, "error.csv");
+  auto& down = j["down_weighted"] = nlohmann::ordered_json::array();
+  for (const smoother::DownWeighted& d : summary.down_weighted)
+    down.push_back({{"source", d.source}, {"stamp", formatSeconds(d.stamp)}, {"mahalanobis", d.mahalanobis}, {"weight", d.weight}});
+  // The solver's own account; its time is a run time, so it stays out of this file (see timing).
+  j["solver"] = {{"termination", summary.termination},
+                 {"iterations", summary.iterations},
+                 {"initial_cost", summary.initial_cost},
+                 {"final_cost", summary.final_cost},
+                 {"states", summary.states},
+                 {"pose_residuals", summary.pose_residuals},
+                 {"twist_residuals", summary.twist_residuals}};
+  return j.dump(2) + "\n";
+}
+
+}  // namespace coloc::replay

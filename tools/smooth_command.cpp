@@ -1,0 +1,93 @@
+// `coloc smooth LOG`: the log through the filter, then every measurement at once through the Ceres
+// smoother; writes the smoothed trajectory, a summary and the error of both along the route.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "coloc/core/error.hpp"
+#include "coloc/replay/log_smoother.hpp"
+#include "coloc/replay/svg_plot.hpp"
+#include "commands.hpp"
+#include "progress.hpp"
+
+namespace coloc::tools {
+
+namespace {
+
+using namespace coloc::replay;
+
+void writeErrorPlot(const SmoothResult& r, const std::string& path) {
+  Plot plot;
+  plot.title = "Position error against ground truth: filter and smoother";
+  plot.x_label = "time since start [s]";
+  plot.y_label = "planar error [m]";
+  plot.y_from_zero = true;
+  auto series = [](const std::vector<ErrorSample>& errors, std::string label, std::string color, Stamp origin) {
+    PlotSeries s{std::move(label), {}, {}, std::move(color), false};
+    for (const ErrorSample& e : errors) s.x.push_back(toSeconds(e.stamp - origin)), s.y.push_back(e.error);
+    return s;
+  };
+  const Stamp origin = r.filter.errors.empty() ? 0 : r.filter.errors.front().stamp;
+  plot.series.push_back(series(r.filter.errors, "filter", "#ff7f0e", origin));
+  plot.series.push_back(series(r.errors, "smoother", "#1f77b4", origin));
+  writeSvg(path, plot);
+}
+
+}  // namespace
+
+void addSmoothCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("smooth", "Smooth a recorded log with every measurement at once (Ceres), beside the filter");
+  static std::string log, config_path, map, registry, out_dir = "coloc_smooth";
+  cmd->add_option("LOG", log, "the recording")->required();
+  cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`)")->check(CLI::ExistingFile);
+  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles): PointCloud2 topics then feed NDT");
+  cmd->add_option("--rsu-registry", registry, "RSU registry (YAML) whose checks the fixes pass (default: rsu.registry of the config)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
+  cmd->callback([] {
+    SmoothOptions options;
+    if (!config_path.empty()) options.replay.config = pipeline::loadConfig(config_path);
+    options.replay.map = map;
+    if (!registry.empty()) options.replay.registry = rsu_client::RsuRegistry::load(registry);
+    options.smoother = smootherOptionsFor(options.replay.config.fusion);
+    ProgressBar progress("filtering");
+    options.replay.progress = [&](double f) { progress.update(f); };
+    const SmoothResult r = smoothLog(log, options);
+    progress.finish();
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    io::writeTumTrajectory(out_dir + "/smoothed.tum", r.smoothed, "coloc smoothed trajectory\nt x y z qx qy qz qw (t: header-stamp clock, s)");
+    std::ofstream(out_dir + "/summary.json") << r.summaryJson(log);
+    const nlohmann::ordered_json timing = {{"replay_wall_s", r.filter.wall_seconds}, {"smoother_wall_s", r.wall_seconds},
+                                           {"solver_s", r.summary.seconds}};
+    std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
+    if (!r.errors.empty()) {
+      std::ofstream csv(out_dir + "/error.csv");
+      csv << "stamp_s,estimator,error_m,along_m,across_m\n";
+      for (const ErrorSample& e : r.filter.errors) csv << formatSeconds(e.stamp) << ",filter," << e.error << "," << e.along << "," << e.across << "\n";
+      for (const ErrorSample& e : r.errors) csv << formatSeconds(e.stamp) << ",smoother," << e.error << "," << e.along << "," << e.across << "\n";
+      writeErrorPlot(r, out_dir + "/error.svg");
+    }
+    std::printf("coloc smooth %s\n  %d states, %d pose and %d twist residuals; Ceres: %s\n", log.c_str(), r.summary.states,
+                r.summary.pose_residuals, r.summary.twist_residuals, r.summary.report.c_str());
+    std::printf("  smoothed %.1f s of log in %.2f s (solver %.2f s); %zu measurements down-weighted by the robust loss\n",
+                toSeconds(r.smoothed.back().stamp - r.smoothed.front().stamp), r.wall_seconds, r.summary.seconds,
+                r.summary.down_weighted.size());
+    for (std::size_t i = 0; i < r.summary.down_weighted.size() && i < 5; ++i) {
+      const auto& d = r.summary.down_weighted[i];
+      std::printf("    %s stamped %s: %.1f sigma, weight %.3f\n", d.source.c_str(), formatSeconds(d.stamp).c_str(), d.mahalanobis, d.weight);
+    }
+    if (!r.errors.empty()) {
+      const ErrorStats f = errorStats(r.filter.errors), s = errorStats(r.errors);
+      std::printf("  position error vs ground truth: filter mean %.4f m (RMSE %.4f), smoother mean %.4f m (RMSE %.4f): %.2fx\n", f.mean,
+                  f.rmse, s.mean, s.rmse, f.mean > 0 ? s.mean / f.mean : 0.0);
+    } else {
+      std::printf("  no ground truth in the log: no error figures\n");
+    }
+    std::printf("  wrote %s/{smoothed.tum, summary.json, timing.json%s}\n", out_dir.c_str(), r.errors.empty() ? "" : ", error.csv, error.svg");
+  });
+}
+
+}  // namespace coloc::tools
