@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -116,9 +117,12 @@ RsuRegistry::RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement p
 }
 
 std::string RsuRegistry::toYaml() const {
-  auto number = [](double v) {
+  auto number = [](double v) {  // the shortest text that reads back to the same double
     char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
+    for (int precision = 15; precision <= 17; ++precision) {
+      std::snprintf(b, sizeof b, "%.*g", precision, v);
+      if (std::strtod(b, nullptr) == v) break;
+    }
     return std::string(b);
   };
   std::ostringstream out;

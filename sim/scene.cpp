@@ -133,12 +133,20 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
     for (std::size_t i = 0; i < root["rsus"].size(); ++i) {
       const YAML::Node n = root["rsus"][i];
       const std::string where = "rsus[" + std::to_string(i) + "]";
-      r.keys(n, where, {"id", "position", "height", "yaw", "lidar_model"});
+      r.keys(n, where, {"id", "position", "height", "yaw", "lidar_model", "survey_error", "clock_offset_ms"});
       ScenarioRsu rsu;
       rsu.id = r.text(r.require(n, "id", where), where + ".id");
       rsu.position = r.vec2(r.require(n, "position", where), where + ".position");
       if (n["height"]) rsu.height = r.positive(n["height"], where + ".height");
       if (n["yaw"]) rsu.yaw = r.number(n["yaw"], where + ".yaw");
+      if (n["survey_error"]) {
+        const auto v = r.numbers(n["survey_error"], where + ".survey_error", 3, "[dx, dy, dyaw_deg]");
+        const Eigen::Vector3d e(v[0], v[1], v[2]);
+        if (e.head<2>().norm() > 10.0 || std::abs(e.z()) > 30.0)
+          r.fail(n["survey_error"], where + ".survey_error", "expected [dx, dy, dyaw_deg] within 10 m and 30 deg");
+        rsu.survey_error = Eigen::Vector3d(e.x(), e.y(), e.z() * M_PI / 180.0);
+      }
+      if (n["clock_offset_ms"]) rsu.clock_offset = 1e-3 * r.inRange(n["clock_offset_ms"], where + ".clock_offset_ms", -1000.0, 1000.0);
       if (n["lidar_model"]) rsu.lidar_model = r.text(n["lidar_model"], where + ".lidar_model");
       if (rsu.lidar_model != "VLP-16" && rsu.lidar_model != "VLP-32C")
         r.fail(n["lidar_model"], where + ".lidar_model", "unknown LiDAR model '" + rsu.lidar_model + "' (VLP-16, VLP-32C)");

@@ -126,7 +126,7 @@ rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& r) {
   if (!model) throw Error("RSU " + r.id + ": no LiDAR model '" + r.lidar_model + "' (VLP-16, VLP-32C)");
   rsu_client::RsuInfo info;
   info.id = r.id;
-  info.position = r.position;
+  info.position = r.position + r.survey_error.head<2>();  // the vehicle knows the surveyed position
   info.height = r.height;
   info.lidar = *model;
   info.coverage_radius = model->range;
@@ -280,6 +280,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       if (!d.found) continue;
       const Stamp ready = at(capture + 0.05 + options.rsu_processing);  // end of the sweep + processing
       const std::optional<Stamp> delivered = r.link.transmit(ready);
+      // The RSU reports in the map frame through its surveyed pose, and stamps on its own clock.
+      const Eigen::Rotation2Dd true_yaw(r.info.yaw), surveyed_yaw(r.info.yaw + r.info.survey_error.z());
+      const Eigen::Vector2d local = true_yaw.inverse() * (d.position - r.info.position);
+      d.position = r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * local;
       const Eigen::Vector2d error = d.position - seen.position;
       summary.fix_errors[r.info.id].push_back(error);
       fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","
@@ -294,7 +298,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         continue;
       }
       io::StampedPose fix;
-      fix.header = {at(capture), "map"};
+      fix.header = {at(capture) + fromSeconds(r.info.clock_offset), "map"};
       fix.measurement.pose.position = {d.position.x(), d.position.y(), 0.0};
       fix.measurement.covariance = Matrix6d::Zero();
       fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;

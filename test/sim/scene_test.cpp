@@ -35,6 +35,21 @@ TEST(Scenario, ErrorsNameTheKeyAndLine) {
   expectError("objects: []\n", "needs route");
 }
 
+TEST(Scenario, RsusCarryTheirSurveyErrorAndClockOffsetInTheScenariosUnits) {
+  const Scenario s = parseScenario(std::string(kRoute) +
+                                       "rsus:\n  - {id: a, position: [10, 5], lidar_model: VLP-16, survey_error: [0.15, -0.05, 0.5], "
+                                       "clock_offset_ms: 20}\n",
+                                   "s.yaml");
+  ASSERT_EQ(s.rsus.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.rsus[0].survey_error.x(), 0.15);
+  EXPECT_DOUBLE_EQ(s.rsus[0].survey_error.y(), -0.05);
+  EXPECT_NEAR(s.rsus[0].survey_error.z(), 0.5 * M_PI / 180.0, 1e-15);  // degrees in the file, radians inside
+  EXPECT_DOUBLE_EQ(s.rsus[0].clock_offset, 0.020);                       // ms in the file, seconds inside
+  expectError(std::string(kRoute) + "rsus:\n  - {id: a, position: [10, 5], survey_error: [0.1, 0.1]}\n",
+              "rsus[0].survey_error: expected [dx, dy, dyaw_deg]");
+  expectError(std::string(kRoute) + "odometry: {}\nrsus: []\n", "odometry: unknown key");
+}
+
 TEST(SurveyMap, SamplesTheSurveyedSurfacesWithinNoise) {
   const Scenario s = parseScenario(
       "ground: {min: [-30, -30], max: [60, 30]}\n"

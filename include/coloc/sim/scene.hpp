@@ -24,6 +24,10 @@ struct ScenarioRsu {
   double height = 2.0;
   double yaw = 0.0;
   std::string lidar_model = "VLP-16";
+  /// The surveyed pose minus the true pose (dx, dy [m], dyaw [rad]): the RSU computes its fixes from
+  /// its surveyed pose, so they are off by it; the vehicle's registry lists the surveyed position.
+  Eigen::Vector3d survey_error = Eigen::Vector3d::Zero();
+  double clock_offset = 0.0;  ///< s, the RSU's clock minus the vehicle's: its fixes are stamped on it
 };
 
 struct Scenario {
