@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -15,8 +16,8 @@ namespace {
 
 // The filter's motion model, written once for doubles and Ceres' Jets: constant speed and yaw rate,
 // moving along yaw + yaw bias.
-template <typename T>
-void propagate(const T* s, double dt, T* out) {
+template <typename T, typename D>
+void propagate(const T* s, D dt, T* out) {
   using std::cos;
   using std::sin;
   const T heading = s[2] + s[3];
@@ -41,8 +42,20 @@ struct MotionResidual {
   Vector6d inverse_sigma;
   template <typename T>
   bool operator()(const T* a, const T* b, T* r) const {
+    // The filter's model between two states, integrated with the trapezoid rule (mean speed, mean
+    // heading, mean yaw rate): exact for constant acceleration, where a forward step is off by a dt^2 / 2,
+    // which over a drive of exact measurements biases what is estimated with it (RSU calibration).
+    using std::cos;
+    using std::sin;
     T predicted[6];
-    propagate(a, dt, predicted);
+    const T speed = 0.5 * (a[4] + b[4]);
+    const T heading = a[2] + a[3] + 0.5 * wrapped(T(b[2] + b[3] - a[2] - a[3]));
+    predicted[0] = a[0] + speed * cos(heading) * dt;
+    predicted[1] = a[1] + speed * sin(heading) * dt;
+    predicted[2] = a[2] + 0.5 * (a[5] + b[5]) * dt;
+    predicted[3] = a[3];
+    predicted[4] = a[4];
+    predicted[5] = a[5];
     for (int i = 0; i < 6; ++i) {
       T d = b[i] - predicted[i];
       if (i == 2) d = wrapped(d);
@@ -91,6 +104,30 @@ struct TwistResidual {
       r[i] = T(0.0);
       for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
     }
+    return true;
+  }
+};
+
+// A roadside fix corrected by its RSU's calibration c = (dx, dy, dyaw, clock offset): the RSU computed
+// it through its surveyed pose, so the vehicle was at ps - d + R(-dyaw) (z - ps), at the fix's stamp
+// minus the clock offset.
+struct CalibratedFixResidual {
+  double dt;  ///< from the state to the fix's stamp (on the RSU's clock)
+  double zx, zy, px, py;
+  Eigen::Matrix2d whitening;
+  template <typename T>
+  bool operator()(const T* s, const T* c, T* r) const {
+    using std::cos;
+    using std::sin;
+    T p[6];
+    propagate(s, T(dt) - c[3], p);
+    const T cy = cos(-c[2]), sy = sin(-c[2]);
+    const double lx = zx - px, ly = zy - py;
+    const T x = px - c[0] + cy * lx - sy * ly;
+    const T y = py - c[1] + sy * lx + cy * ly;
+    const T e0 = p[0] - x, e1 = p[1] - y;
+    r[0] = whitening(0, 0) * e0;
+    r[1] = whitening(1, 0) * e0 + whitening(1, 1) * e1;
     return true;
   }
 };
@@ -155,8 +192,15 @@ double chiSquareQuantile(int dof, double alpha) {
   return 0.5 * (lo + hi);
 }
 
+struct CalibratedRsu {
+  std::string source;
+  Eigen::Vector2d position;
+  bool clock;
+};
+
 struct Smoother::Impl {
   SmootherOptions options;
+  std::vector<CalibratedRsu> calibrated;
   std::vector<StoredPose> poses;
   std::vector<StoredTwist> twists;
   std::map<Stamp, Vector6d> guesses;
@@ -238,6 +282,10 @@ bool Smoother::addTwist(const std::string& source, const TwistMeasurement& measu
   return true;
 }
 
+void Smoother::calibrateRsu(const std::string& source, const Eigen::Vector2d& surveyed_position, bool clock) {
+  impl_->calibrated.push_back({source, surveyed_position, clock});
+}
+
 void Smoother::addGuess(Stamp stamp, const Vector6d& state) {
   if (state.allFinite()) impl_->guesses[stamp] = state;
 }
@@ -274,6 +322,12 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
     double threshold;  ///< squared whitened norm where the loss starts to down-weight
   };
   std::vector<Added> added;
+  // One block per calibrated RSU, (dx, dy, dyaw, clock offset) starting at 0; without a clock, the
+  // offset is held at 0.
+  std::vector<std::array<double, 4>> calibration(impl_->calibrated.size(), std::array<double, 4>{0.0, 0.0, 0.0, 0.0});
+  std::map<std::string, std::size_t> calibration_of;
+  for (std::size_t i = 0; i < impl_->calibrated.size(); ++i) calibration_of[impl_->calibrated[i].source] = i;
+  std::vector<int> fixes_of(impl_->calibrated.size(), 0);
   auto loss = [&](int m) -> std::pair<ceres::LossFunction*, double> {
     const double delta2 = chiSquareQuantile(m, o.gate_alpha);
     return {o.robust ? new ceres::HuberLoss(std::sqrt(delta2)) : nullptr, delta2};
@@ -281,6 +335,19 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
   for (const StoredPose& p : impl_->poses) {
     if (p.stamp < first || p.stamp > last) continue;
     const std::size_t k = std::min(n - 1, static_cast<std::size_t>((p.stamp - first) / step));
+    const auto calibrated = calibration_of.find(p.source);
+    if (calibrated != calibration_of.end() && p.m == 2 && p.component[0] == 0 && p.component[1] == 1) {
+      const CalibratedRsu& rsu = impl_->calibrated[calibrated->second];
+      auto* f = new CalibratedFixResidual{toSeconds(p.stamp - result.states[k].stamp), p.value[0], p.value[1], rsu.position.x(), rsu.position.y(),
+                                          p.whitening.topLeftCorner<2, 2>()};
+      const auto [l, delta2] = loss(2);
+      double* block = calibration[calibrated->second].data();
+      added.push_back({problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CalibratedFixResidual, 2, 6, 4>(f), l, blockOf(k), block),
+                       &p.source, p.stamp, delta2});
+      ++fixes_of[calibrated->second];
+      ++result.summary.pose_residuals;
+      continue;
+    }
     PoseResidual* r = new PoseResidual{toSeconds(p.stamp - result.states[k].stamp), p.m, {}, {}, p.whitening};
     for (int j = 0; j < p.m; ++j) r->component[j] = p.component[j], r->value[j] = p.value[j];
     const auto [l, delta2] = loss(p.m);
@@ -288,6 +355,8 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
                      &p.source, p.stamp, delta2});
     ++result.summary.pose_residuals;
   }
+  for (std::size_t i = 0; i < impl_->calibrated.size(); ++i)
+    if (!impl_->calibrated[i].clock && fixes_of[i] > 0) problem.SetManifold(calibration[i].data(), new ceres::SubsetManifold(4, {3}));
   for (const StoredTwist& t : impl_->twists) {
     if (t.stamp < first || t.stamp > last || n < 2) continue;
     const std::size_t k = std::min(n - 2, static_cast<std::size_t>((t.stamp - first) / step));
@@ -328,6 +397,39 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
     double s = 0.0;
     for (double r : residuals) s += r * r;
     if (s > a.threshold) result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(s), std::sqrt(a.threshold / s)});
+  }
+
+  // The calibrations, with their uncertainty; a block the drive does not determine is said to be so.
+  const char* rank_note = "the drive does not determine it: no anchoring pose source (NDT), or too few fixes in too little geometry";
+  for (std::size_t i = 0; i < impl_->calibrated.size(); ++i) {
+    RsuCalibration c;
+    c.source = impl_->calibrated[i].source;
+    c.dx = calibration[i][0], c.dy = calibration[i][1], c.dyaw = calibration[i][2], c.clock_offset = calibration[i][3];
+    if (fixes_of[i] == 0) {
+      c.note = "no fix of this RSU in the span";
+    } else {
+      // Sparse QR over the whole problem (a dense SVD would be too big); a rank-deficient Jacobian, a
+      // calibration the drive does not determine, makes it fail, and that is what it then says.
+      ceres::Covariance::Options co;
+      co.algorithm_type = ceres::SPARSE_QR;
+      co.num_threads = std::max(1, o.threads);
+      ceres::Covariance covariance(co);
+      double* block = calibration[i].data();
+      const std::vector<std::pair<const double*, const double*>> wanted = {{block, block}};
+      double cov[16];
+      if (covariance.Compute(wanted, &problem) && covariance.GetCovarianceBlock(block, block, cov)) {
+        const Eigen::Map<Eigen::Matrix4d> C(cov);
+        c.sd_dx = std::sqrt(std::max(0.0, C(0, 0)));
+        c.sd_dy = std::sqrt(std::max(0.0, C(1, 1)));
+        c.sd_dyaw = std::sqrt(std::max(0.0, C(2, 2)));
+        c.sd_clock_offset = std::sqrt(std::max(0.0, C(3, 3)));
+        c.observable = c.sd_dx < 1.0 && c.sd_dy < 1.0 && c.sd_dyaw < 0.1 && (!impl_->calibrated[i].clock || c.sd_clock_offset < 0.1);
+        if (!c.observable) c.note = rank_note;
+      } else {
+        c.note = rank_note;
+      }
+    }
+    result.calibrations.push_back(c);
   }
 
   if (o.covariances && result.summary.usable()) {

@@ -119,3 +119,75 @@ TEST(Smoother, ChiSquareQuantilesMatchTheTables) {
 
 }  // namespace
 }  // namespace coloc::smoother
+
+namespace coloc::smoother {
+namespace {
+
+// A drive past an RSU along x, speeding up from 4 to 12 m/s, so that a clock offset (a shift growing
+// with speed) and an along-track survey offset (constant) differ; on a circle at constant speed they
+// would not, nor would a rotation about the RSU. `anchored`: NDT-like poses (2 cm, 0.2 deg) every
+// 100 ms. The RSU at (40, -8) has its survey off by (0.15 m, -0.05 m, 0.5 deg) and its clock 20 ms ahead.
+struct BendDrive {
+  static constexpr double kV0 = 4.0, kA = 0.7;
+  static Vector6d at(double t) { return (Vector6d() << kV0 * t + 0.5 * kA * t * t, 0.0, 0.0, 0.0, kV0 + kA * t, 0.0).finished(); }
+};
+
+Smoother bendDrive(bool anchored, const Eigen::Vector3d& survey_error, double clock_offset) {
+  Smoother s;
+  const Eigen::Vector2d rsu_true(40.0, -8.0);
+  const Eigen::Vector2d rsu_surveyed = rsu_true + survey_error.head<2>();
+  for (int k = 0; k <= 600; ++k) {
+    const double t = k * 0.02;
+    const Vector6d x = BendDrive::at(t);
+    TwistMeasurement tw;
+    tw.stamp = at(t);
+    tw.linear = {x[4], 0.0, 0.0};
+    tw.angular = {0.0, 0.0, x[5]};
+    tw.covariance = Matrix6d::Zero();
+    tw.covariance.diagonal() << 0.0004, kInfinity, kInfinity, kInfinity, kInfinity, 0.0001;
+    s.addTwist("odom", tw);
+    s.addGuess(at(t), x);
+    if (k % 5 == 0 && anchored) {
+      PoseMeasurement ndt;
+      ndt.stamp = at(t);
+      ndt.pose.position = {x[0], x[1], 0.0};
+      ndt.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, x[2]);
+      ndt.covariance = Matrix6d::Zero();
+      ndt.covariance.diagonal() << 4e-4, 4e-4, kInfinity, kInfinity, kInfinity, 1.2e-5;
+      s.addPose("ndt", ndt);
+    }
+    if (k % 5 == 2) {  // the RSU's fix of where the vehicle is at t, through its surveyed pose, on its clock
+      const Eigen::Vector2d local = Eigen::Rotation2Dd(0.0).inverse() * (x.head<2>() - rsu_true);
+      const Eigen::Vector2d reported = rsu_surveyed + Eigen::Rotation2Dd(survey_error.z()) * local;
+      EXPECT_TRUE(s.addPose("/rsu/a/fix", fix(t + clock_offset, reported.x(), reported.y(), 1e-5)));
+    }
+  }
+  s.calibrateRsu("/rsu/a/fix", rsu_surveyed);
+  return s;
+}
+
+TEST(RsuCalibration, RecoversASurveyAndClockErrorFromOneDriveAnchoredByNdt) {
+  const Eigen::Vector3d error(0.15, -0.05, 0.5 * M_PI / 180.0);
+  const SmootherResult r = bendDrive(true, error, 0.020).solve(at(0.0), at(12.0));
+  ASSERT_TRUE(r.summary.usable()) << r.summary.report;
+
+  ASSERT_EQ(r.calibrations.size(), 1u);
+  const RsuCalibration& c = r.calibrations[0];
+  EXPECT_TRUE(c.observable) << c.note;
+  EXPECT_NEAR(c.dx, 0.15, 0.01);
+  EXPECT_NEAR(c.dy, -0.05, 0.01);
+  EXPECT_NEAR(c.dyaw * 180.0 / M_PI, 0.5, 0.05);
+  EXPECT_NEAR(c.clock_offset, 0.020, 0.002);
+  EXPECT_GT(c.sd_dx, 0.0);
+  EXPECT_LT(c.sd_dx, 0.01);
+}
+
+TEST(RsuCalibration, WithoutAnAnchoringSourceItIsReportedUnobservableNotInvented) {
+  const SmootherResult r = bendDrive(false, Eigen::Vector3d(0.15, -0.05, 0.01), 0.020).solve(at(0.0), at(12.0));
+  ASSERT_EQ(r.calibrations.size(), 1u);
+  EXPECT_FALSE(r.calibrations[0].observable);
+  EXPECT_FALSE(r.calibrations[0].note.empty());
+}
+
+}  // namespace
+}  // namespace coloc::smoother

@@ -54,6 +54,19 @@ struct SmootherSummary {
   bool usable() const { return termination == "CONVERGENCE" || termination == "NO_CONVERGENCE"; }
 };
 
+/// An RSU's calibration as estimated: the offset of its surveyed pose (surveyed minus true: dx, dy,
+/// and dyaw about its surveyed position) and of its clock (its clock minus the vehicle's), in the
+/// convention of the twin's survey_error and clock_offset_ms.
+struct RsuCalibration {
+  std::string source;
+  double dx = 0.0, dy = 0.0, dyaw = 0.0, clock_offset = 0.0;  ///< m, m, rad, s
+  double sd_dx = 0.0, sd_dy = 0.0, sd_dyaw = 0.0, sd_clock_offset = 0.0;
+  /// False when the drive does not determine it (no anchoring pose source, a degenerate geometry):
+  /// the values are then the starting point, not an estimate.
+  bool observable = false;
+  std::string note;  ///< why not, when not
+};
+
 struct SmoothedState {
   Stamp stamp = 0;
   Vector6d state = Vector6d::Zero();  ///< [x, y, yaw, yaw_bias, vx, wz]
@@ -63,6 +76,7 @@ struct SmoothedState {
 struct SmootherResult {
   std::vector<SmoothedState> states;
   SmootherSummary summary;
+  std::vector<RsuCalibration> calibrations;  ///< one per calibrateRsu, in that order
 };
 
 class Smoother {
@@ -81,6 +95,10 @@ class Smoother {
   /// A first guess of the state at a stamp (the filter's estimates, say); states between guesses are
   /// interpolated, and the first guess also anchors a weak prior on the yaw bias.
   void addGuess(Stamp stamp, const Vector6d& state);
+  /// Estimates the survey and clock offsets of the RSU whose fixes come as `source`, jointly with the
+  /// trajectory: its fixes are corrected by them before they are compared with the state. Other pose
+  /// sources (NDT) anchor the trajectory; without them nothing here is observable, and is said so.
+  void calibrateRsu(const std::string& source, const Eigen::Vector2d& surveyed_position, bool clock = true);
 
   /// Solves for states every 1/rate from `first` to `last`. Throws coloc::Error when there are no
   /// guesses to start from or the span is empty.
