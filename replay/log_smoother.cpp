@@ -1,9 +1,12 @@
 #include "coloc/replay/log_smoother.hpp"
 
+#include <Eigen/Geometry>
 #include <chrono>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "coloc/core/error.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
 
 namespace coloc::replay {
 
@@ -30,9 +33,18 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   for (const auto& [stamp, state] : f.fused_states) s.addGuess(stamp, state);
   for (const auto& [source, pose] : f.filter_poses) s.addPose(source, pose);
   for (const auto& [source, twist] : f.filter_twists) s.addTwist(source, twist);
+  std::optional<rsu_client::RsuRegistry> registry = options.replay.registry;
+  if (!registry && !options.replay.config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(options.replay.config.rsu.registry);
+  if (registry) result.registry = *registry;
+  if (options.calibrate_rsus) {
+    if (!registry) throw Error("smooth: --calibrate-rsus needs an RSU registry (rsu.registry or --rsu-registry)");
+    for (const rsu_client::RsuInfo& rsu : registry->rsus()) s.calibrateRsu(rsu_client::fixTopic(rsu.id), rsu.position);
+  }
   const smoother::SmootherResult r = s.solve(f.fused_states.front().first, f.fused_states.back().first);
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.summary = r.summary;
+  if (registry)
+    for (std::size_t i = 0; i < r.calibrations.size() && i < registry->rsus().size(); ++i) result.calibrations[registry->rsus()[i].id] = r.calibrations[i];
   result.states = r.states;
   for (const smoother::SmoothedState& st : r.states) {
     io::TrajectoryPoint p;
@@ -57,6 +69,26 @@ nlohmann::ordered_json errorJson(const std::vector<ErrorSample>& errors, const c
 
 }  // namespace
 
+rsu_client::RsuRegistry SmoothResult::calibratedRegistry() const {
+  std::vector<rsu_client::RsuInfo> rsus = registry.rsus();
+  for (rsu_client::RsuInfo& rsu : rsus) {
+    const auto found = calibrations.find(rsu.id);
+    if (found == calibrations.end() || !found->second.observable) continue;
+    // The fixes were already corrected by the old calibration: the new one is what remained.
+    const smoother::RsuCalibration& c = found->second;
+    rsu_client::RsuCalibrationEntry e = rsu.calibration.value_or(rsu_client::RsuCalibrationEntry{});
+    const Eigen::Vector2d old_d(e.dx, e.dy);
+    // Correcting by e, then by c, is correcting by d = c + R(-c.dyaw) e, dyaw = c.dyaw + e.dyaw.
+    const Eigen::Vector2d d = Eigen::Vector2d(c.dx, c.dy) + Eigen::Rotation2Dd(-c.dyaw) * old_d;
+    e.dx = d.x();
+    e.dy = d.y();
+    e.dyaw += c.dyaw;
+    e.clock_offset += c.clock_offset;
+    rsu.calibration = e;
+  }
+  return rsu_client::RsuRegistry(rsus, registry.placement());
+}
+
 std::string SmoothResult::summaryJson(const std::string& log) const {
   nlohmann::ordered_json j;
   j["log"] = log;
@@ -66,6 +98,22 @@ std::string SmoothResult::summaryJson(const std::string& log) const {
   auto& down = j["down_weighted"] = nlohmann::ordered_json::array();
   for (const smoother::DownWeighted& d : summary.down_weighted)
     down.push_back({{"source", d.source}, {"stamp", formatSeconds(d.stamp)}, {"mahalanobis", d.mahalanobis}, {"weight", d.weight}});
+  if (!calibrations.empty()) {
+    auto& cal = j["rsu_calibration"] = nlohmann::ordered_json::object();
+    for (const auto& [id, c] : calibrations) {
+      nlohmann::ordered_json o = {{"dx_m", c.dx},
+                                  {"dy_m", c.dy},
+                                  {"dyaw_deg", c.dyaw * 180.0 / M_PI},
+                                  {"clock_offset_ms", c.clock_offset * 1e3},
+                                  {"sd_dx_m", c.sd_dx},
+                                  {"sd_dy_m", c.sd_dy},
+                                  {"sd_dyaw_deg", c.sd_dyaw * 180.0 / M_PI},
+                                  {"sd_clock_offset_ms", c.sd_clock_offset * 1e3},
+                                  {"observable", c.observable}};
+      if (!c.note.empty()) o["note"] = c.note;
+      cal[id] = o;
+    }
+  }
   // The solver's own account; its time is a run time, so it stays out of this file (see timing).
   j["solver"] = {{"termination", summary.termination},
                  {"iterations", summary.iterations},

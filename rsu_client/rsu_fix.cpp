@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+
+#include <Eigen/Geometry>
 #include <sstream>
 
 namespace coloc::rsu_client {
@@ -21,7 +23,26 @@ const char* toString(FixRejection reason) {
 
 FixChecker::FixChecker(RsuRegistry registry, FixCheckConfig config) : registry_(std::move(registry)), config_(config) {}
 
-FixVerdict FixChecker::check(const RsuFix& fix, Stamp now) {
+namespace {
+
+// A fix as its RSU would have sent it with a true survey and clock: the RSU computed it through its
+// surveyed pose (off by dx, dy, dyaw) and stamped it on its clock (off by clock_offset).
+RsuFix corrected(const RsuFix& fix, const RsuInfo& rsu) {
+  const RsuCalibrationEntry& c = *rsu.calibration;
+  const Eigen::Vector2d local = Eigen::Vector2d(fix.x, fix.y) - rsu.position;
+  const Eigen::Vector2d p = rsu.position - Eigen::Vector2d(c.dx, c.dy) + Eigen::Rotation2Dd(-c.dyaw) * local;
+  RsuFix out = fix;
+  out.x = p.x();
+  out.y = p.y();
+  if (out.yaw) *out.yaw -= c.dyaw;
+  out.stamp = fix.stamp - fromSeconds(c.clock_offset);
+  return out;
+}
+
+}  // namespace
+
+FixVerdict FixChecker::check(const RsuFix& received, Stamp now) {
+  const RsuFix& fix = received;
   FixCounters& c = counters_[fix.rsu_id];
   ++c.received;
   FixVerdict v;
@@ -37,6 +58,19 @@ FixVerdict FixChecker::check(const RsuFix& fix, Stamp now) {
   if (!rsu) return reject(FixRejection::kUnknownRsu, "no such RSU in the registry", c.unknown_rsu);
   if (!std::isfinite(fix.x) || !std::isfinite(fix.y) || (fix.yaw && !std::isfinite(*fix.yaw)))
     return reject(FixRejection::kNonFinite, "position or yaw is not finite", c.non_finite);
+  return checkKnown(rsu->calibration ? corrected(fix, *rsu) : fix, now, *rsu, c, v);
+}
+
+FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& known, FixCounters& c, FixVerdict& v) {
+  const RsuInfo* rsu = &known;
+  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) {
+    ++counter;
+    v.rejection = reason;
+    std::ostringstream out;
+    out << "fix from '" << fix.rsu_id << "' stamped " << formatSeconds(fix.stamp) << " rejected (" << toString(reason) << "): " << why;
+    v.detail = out.str();
+    return v;
+  };
   const double distance = (Eigen::Vector2d(fix.x, fix.y) - rsu->position).norm();
   if (distance > rsu->coverage_radius) {
     std::ostringstream why;

@@ -30,7 +30,7 @@ namespace {
 
 RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) {
   const std::string where = "rsus[" + std::to_string(index) + "]";
-  r.allowKeys(node, where, {"id", "position", "height", "lidar_model", "coverage_radius", "identity", "calibrated_variance"});
+  r.allowKeys(node, where, {"id", "position", "height", "lidar_model", "coverage_radius", "identity", "calibrated_variance", "calibration"});
   RsuInfo rsu;
   bool has_position = false, has_model = false;
   std::optional<double> radius;
@@ -59,6 +59,18 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
       rsu.identity = r.text(entry.second, full);
     } else if (key == "calibrated_variance") {
       rsu.calibrated_variance = r.positive(entry.second, full);
+    } else if (key == "calibration") {
+      r.allowKeys(entry.second, full, {"dx", "dy", "dyaw_deg", "clock_offset_ms"});
+      RsuCalibrationEntry c;
+      for (const auto& e : entry.second) {
+        const std::string k = e.first.as<std::string>();
+        const std::string kk = full + "." + k;
+        if (k == "dx") c.dx = r.inRange(e.second, kk, -10.0, 10.0);
+        else if (k == "dy") c.dy = r.inRange(e.second, kk, -10.0, 10.0);
+        else if (k == "dyaw_deg") c.dyaw = r.inRange(e.second, kk, -30.0, 30.0) * M_PI / 180.0;
+        else c.clock_offset = 1e-3 * r.inRange(e.second, kk, -1000.0, 1000.0);
+      }
+      rsu.calibration = c;
     }
   }
   if (rsu.id.empty()) r.fail(node, where, "needs an id");
@@ -137,6 +149,10 @@ std::string RsuRegistry::toYaml() const {
         << "    coverage_radius: " << number(r.coverage_radius) << "\n"
         << "    identity: \"" << r.identity << "\"\n";
     if (r.calibrated_variance) out << "    calibrated_variance: " << number(*r.calibrated_variance) << "\n";
+    if (r.calibration)
+      out << "    calibration: {dx: " << number(r.calibration->dx) << ", dy: " << number(r.calibration->dy)
+          << ", dyaw_deg: " << number(r.calibration->dyaw * 180.0 / M_PI) << ", clock_offset_ms: " << number(r.calibration->clock_offset * 1e3)
+          << "}\n";
   }
   return out.str();
 }

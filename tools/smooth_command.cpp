@@ -45,12 +45,16 @@ void addSmoothCommand(CLI::App& app) {
   cmd->add_option("--rsu-registry", registry, "RSU registry (YAML) whose checks the fixes pass (default: rsu.registry of the config)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
+  static bool calibrate = false;
+  cmd->add_flag("--calibrate-rsus", calibrate,
+                "estimate each RSU's survey and clock offsets with the trajectory; writes rsu_calibrated.yaml for the next drives");
   cmd->callback([] {
     SmoothOptions options;
     if (!config_path.empty()) options.replay.config = pipeline::loadConfig(config_path);
     options.replay.map = map;
     if (!registry.empty()) options.replay.registry = rsu_client::RsuRegistry::load(registry);
     options.smoother = smootherOptionsFor(options.replay.config.fusion);
+    options.calibrate_rsus = calibrate;
     ProgressBar progress("filtering");
     options.replay.progress = [&](double f) { progress.update(f); };
     const SmoothResult r = smoothLog(log, options);
@@ -78,6 +82,18 @@ void addSmoothCommand(CLI::App& app) {
     for (std::size_t i = 0; i < r.summary.down_weighted.size() && i < 5; ++i) {
       const auto& d = r.summary.down_weighted[i];
       std::printf("    %s stamped %s: %.1f sigma, weight %.3f\n", d.source.c_str(), formatSeconds(d.stamp).c_str(), d.mahalanobis, d.weight);
+    }
+    for (const auto& [id, c] : r.calibrations) {
+      if (c.observable)
+        std::printf("  RSU %s calibration: survey %+.4f m, %+.4f m, %+.3f deg; clock %+.2f ms (sd %.4f m, %.4f m, %.3f deg, %.2f ms)\n",
+                    id.c_str(), c.dx, c.dy, c.dyaw * 180.0 / M_PI, c.clock_offset * 1e3, c.sd_dx, c.sd_dy, c.sd_dyaw * 180.0 / M_PI,
+                    c.sd_clock_offset * 1e3);
+      else
+        std::printf("  RSU %s calibration: not determined (%s)\n", id.c_str(), c.note.c_str());
+    }
+    if (calibrate) {
+      std::ofstream(out_dir + "/rsu_calibrated.yaml") << r.calibratedRegistry().toYaml();
+      std::printf("  wrote %s/rsu_calibrated.yaml: the registry with the calibrations found, for the next drives\n", out_dir.c_str());
     }
     if (!r.errors.empty()) {
       const ErrorStats f = errorStats(r.filter.errors), s = errorStats(r.errors);

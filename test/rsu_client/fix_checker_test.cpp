@@ -98,3 +98,30 @@ TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {
 
 }  // namespace
 }  // namespace coloc::rsu_client
+
+namespace coloc::rsu_client {
+namespace {
+
+TEST(FixChecker, ACalibratedRsusFixesAreCorrectedForItsSurveyAndClock) {
+  // Surveyed at (30.15, -7.05), 0.5 deg and its clock 20 ms off: a vehicle truly at (20, -1) at t is
+  // reported through the surveyed pose and stamped t + 20 ms; the calibration found on an earlier drive
+  // undoes both.
+  const RsuRegistry registry = RsuRegistry::parse(
+      "rsus:\n  - {id: a, position: [30.15, -7.05], lidar_model: VLP-32C, "
+      "calibration: {dx: 0.15, dy: -0.05, dyaw_deg: 0.5, clock_offset_ms: 20}}\n",
+      "rsu.yaml");
+  const Eigen::Vector2d truth(20.0, -1.0), rsu_true(30.0, -7.0), rsu_surveyed(30.15, -7.05);
+  const Eigen::Vector2d reported = rsu_surveyed + Eigen::Rotation2Dd(0.5 * M_PI / 180.0) * (truth - rsu_true);
+  const Stamp t = 1'700'000'000'000'000'000LL;
+  FixChecker checker(registry);
+  const FixVerdict v = checker.check({t + 20'000'000, "a", reported.x(), reported.y(), std::nullopt}, t + 60'000'000);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.pose.position.x(), truth.x(), 1e-9);
+  EXPECT_NEAR(v.measurement.pose.position.y(), truth.y(), 1e-9);
+  EXPECT_EQ(v.measurement.stamp, t);
+  // And the registry writes it back as it read it.
+  EXPECT_EQ(RsuRegistry::parse(registry.toYaml(), "again").toYaml(), registry.toYaml());
+}
+
+}  // namespace
+}  // namespace coloc::rsu_client

@@ -3,6 +3,7 @@
 // prediction, the fix checks, the speed scale: the smoother gets exactly what the filter got, and
 // the filter's states as its first guess), then every pose and twist solved for at once by the Ceres
 // smoother, and both trajectories scored against the log's ground truth.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@ struct SmoothOptions {
   /// The smoother's settings; rate, process noise and the robust loss's alpha follow the filter's
   /// configuration (replay.config.fusion) unless changed after `smootherOptionsFor`.
   smoother::SmootherOptions smoother;
+  /// Estimate each registered RSU's survey and clock offsets with the trajectory (its fixes must be
+  /// anchored by NDT or another pose source).
+  bool calibrate_rsus = false;
 };
 
 /// The smoother's settings that match a filter configuration: tick rate, process noise, yaw-bias
@@ -29,6 +33,13 @@ struct SmoothResult {
   std::vector<ErrorSample> errors;             ///< the smoothed pose against ground truth
   smoother::SmootherSummary summary;
   double wall_seconds = 0.0;                   ///< the smoothing alone
+  /// Per RSU id, with calibrate_rsus. Observable ones can go into the next drives' registry.
+  std::map<std::string, smoother::RsuCalibration> calibrations;
+  rsu_client::RsuRegistry registry;            ///< the registry used; `calibratedRegistry` adds the findings
+
+  /// The registry with each observable calibration as the RSU's `calibration` entry, added to what it
+  /// had (a previous calibration is composed with the new one).
+  rsu_client::RsuRegistry calibratedRegistry() const;
 
   /// summary.json of `coloc smooth`: position_error as `coloc fuse` reports it, the filter's beside it,
   /// the solver's summary and what the robust loss down-weighted.

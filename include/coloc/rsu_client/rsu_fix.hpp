@@ -52,6 +52,8 @@ class FixChecker {
   const RsuRegistry& registry() const { return registry_; }
 
  private:
+  /// The checks after the RSU is known and its calibration applied.
+  FixVerdict checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& rsu, FixCounters& counters, FixVerdict& verdict);
   RsuRegistry registry_;
   FixCheckConfig config_;
   std::map<std::string, FixCounters> counters_;

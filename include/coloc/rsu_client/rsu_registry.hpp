@@ -24,6 +24,15 @@ const LidarModel* findLidarModel(const std::string& name);
 /// (variance = sigma, the figure read in m^2); `standard_deviation` reads it as metres (variance = sigma^2).
 enum class CovariancePlacement { kPublished, kStandardDeviation };
 
+/// An RSU's calibration found by driving past it (`coloc smooth --calibrate-rsus`): its surveyed pose
+/// minus its true pose (dx, dy, and dyaw about its surveyed position) and its clock minus the
+/// vehicle's. Its fixes are corrected by it before anything else looks at them.
+struct RsuCalibrationEntry {
+  double dx = 0.0, dy = 0.0;  ///< m
+  double dyaw = 0.0;          ///< rad (dyaw_deg in the file)
+  double clock_offset = 0.0;  ///< s (clock_offset_ms in the file)
+};
+
 struct RsuInfo {
   std::string id;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< map frame, m
@@ -34,6 +43,7 @@ struct RsuInfo {
   /// x/y variance measured for this RSU (m^2), e.g. by driving a surveyed vehicle past it; when set,
   /// its fixes carry it instead of the model's figure, whatever the placement.
   std::optional<double> calibrated_variance;
+  std::optional<RsuCalibrationEntry> calibration;
 };
 
 class RsuRegistry {
