@@ -1,5 +1,6 @@
 // `coloc smooth LOG`: the log through the filter, then every measurement at once through the Ceres
 // smoother; writes the smoothed trajectory, a summary and the error of both along the route.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +65,24 @@ void addSmoothCommand(CLI::App& app) {
     if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
     io::writeTumTrajectory(out_dir + "/smoothed.tum", r.smoothed, "coloc smoothed trajectory\nt x y z qx qy qz qw (t: header-stamp clock, s)");
     std::ofstream(out_dir + "/summary.json") << r.summaryJson(log);
+    {
+      // Every state with its marginal position uncertainty (empty where the drive does not determine it).
+      std::ofstream states(out_dir + "/smoothed.csv");
+      states << "stamp_s,x,y,yaw,yaw_bias,vx,wz,sd_x_m,sd_y_m,cov_xy_m2\n";
+      char line[400];
+      for (const smoother::SmoothedState& st : r.states) {
+        std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,", formatSeconds(st.stamp).c_str(), st.state[0], st.state[1],
+                      st.state[2], st.state[3], st.state[4], st.state[5]);
+        states << line;
+        if (st.position_covariance) {
+          const Eigen::Matrix2d& c = *st.position_covariance;
+          std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g\n", std::sqrt(std::max(0.0, c(0, 0))), std::sqrt(std::max(0.0, c(1, 1))), c(0, 1));
+          states << line;
+        } else {
+          states << ",,\n";
+        }
+      }
+    }
     const nlohmann::ordered_json timing = {{"replay_wall_s", r.filter.wall_seconds}, {"smoother_wall_s", r.wall_seconds},
                                            {"solver_s", r.summary.seconds}};
     std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
@@ -102,7 +121,7 @@ void addSmoothCommand(CLI::App& app) {
     } else {
       std::printf("  no ground truth in the log: no error figures\n");
     }
-    std::printf("  wrote %s/{smoothed.tum, summary.json, timing.json%s}\n", out_dir.c_str(), r.errors.empty() ? "" : ", error.csv, error.svg");
+    std::printf("  wrote %s/{smoothed.tum, smoothed.csv, summary.json, timing.json%s}\n", out_dir.c_str(), r.errors.empty() ? "" : ", error.csv, error.svg");
   });
 }
 
