@@ -174,7 +174,10 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   const bool keep = options.keep_filter_inputs;
   pipe.onEstimate([&](const fusion::Estimate& e) {
     result.fused.push_back({e.stamp, e.pose});
-    if (keep) result.fused_states.emplace_back(e.stamp, e.state);
+    if (keep) {
+      result.fused_states.emplace_back(e.stamp, e.state);
+      result.fused_state_covariances.push_back(e.state_covariance);
+    }
   });
   pipe.onPoseInput([&](const std::string& source, const PoseMeasurement& p) {
     result.pose_inputs.push_back({p.stamp, p.pose});

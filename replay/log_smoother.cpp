@@ -22,13 +22,83 @@ smoother::SmootherOptions smootherOptionsFor(const fusion::EkfConfig& filter) {
   return o;
 }
 
+namespace {
+
+io::TrajectoryPoint pointOf(const smoother::SmoothedState& st) {
+  io::TrajectoryPoint p;
+  p.stamp = st.stamp;
+  p.pose.position = {st.state[0], st.state[1], 0.0};
+  p.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, st.state[2] + st.state[3]);  // heading, as the filter gives it
+  return p;
+}
+
+// The filter's errors at exactly the stamps the smoother produced, so that the two compare like for like.
+void matchFilterErrors(SmoothResult& r) {
+  std::size_t i = 0;
+  for (const ErrorSample& e : r.errors) {
+    while (i < r.filter.errors.size() && r.filter.errors[i].stamp < e.stamp) ++i;
+    if (i < r.filter.errors.size() && r.filter.errors[i].stamp == e.stamp) r.filter_errors_matched.push_back(r.filter.errors[i]);
+  }
+}
+
+// Windows of `window` seconds every `window_step`, each from the filter's state at its start.
+void smoothFixedLag(const SmoothOptions& options, SmoothResult& result) {
+  const ReplayResult& f = result.filter;
+  FixedLagReport report;
+  report.window = options.window;
+  report.step = options.window_step;
+  const Duration window = fromSeconds(options.window), step = fromSeconds(std::max(options.window_step, 1e-3));
+  smoother::SmootherOptions o = options.smoother;
+  o.covariances = false;  // a vehicle running behind the filter wants the states, now
+  const Stamp first = f.fused_states.front().first, last = f.fused_states.back().first;
+  std::size_t start_index = 0;
+  for (Stamp end = first + window; end <= last; end += step) {
+    const Stamp begin = end - window;
+    while (start_index + 1 < f.fused_states.size() && f.fused_states[start_index].first < begin) ++start_index;
+    smoother::Smoother s(o);
+    for (std::size_t i = start_index; i < f.fused_states.size() && f.fused_states[i].first <= end; ++i) s.addGuess(f.fused_states[i].first, f.fused_states[i].second);
+    s.addPrior(f.fused_states[start_index].first, f.fused_states[start_index].second, f.fused_state_covariances[start_index]);
+    for (const auto& [source, pose] : f.filter_poses)
+      if (pose.stamp >= begin && pose.stamp <= end) s.addPose(source, pose);
+    for (const auto& [source, twist] : f.filter_twists)
+      if (twist.stamp >= begin && twist.stamp <= end) s.addTwist(source, twist);
+    const auto t0 = std::chrono::steady_clock::now();
+    const smoother::SmootherResult r = s.solve(f.fused_states[start_index].first, end);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++report.windows;
+    report.mean_solve_seconds += seconds;
+    report.max_solve_seconds = std::max(report.max_solve_seconds, seconds);
+    result.summary = r.summary;  // the last window's account
+    for (const smoother::SmoothedState& st : r.states)
+      if (st.stamp > end - step || result.smoothed.empty()) {
+        if (!result.smoothed.empty() && st.stamp <= result.smoothed.back().stamp) continue;
+        result.states.push_back(st);
+        result.smoothed.push_back(pointOf(st));
+      }
+  }
+  if (report.windows) report.mean_solve_seconds /= report.windows;
+  result.fixed_lag = report;
+}
+
+}  // namespace
+
 SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
+  if (options.window > 0.0 && options.calibrate_rsus)
+    throw Error("smooth: RSU calibration takes the whole drive at once; it does not run in a fixed-lag window");
+  if (options.window < 0.0 || !std::isfinite(options.window)) throw Error("smooth: the window must be a finite number of seconds >= 0");
   options.replay.keep_filter_inputs = true;
   SmoothResult result;
   result.filter = replayLog(log_path, options.replay);
   const ReplayResult& f = result.filter;
   if (f.fused_states.size() < 2) throw Error(log_path + ": the filter gave fewer than two estimates: nothing to smooth");
   const auto start = std::chrono::steady_clock::now();
+  if (options.window > 0.0) {
+    smoothFixedLag(options, result);
+    result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.errors = evaluate(result.smoothed, f.ground_truth, fromSeconds(options.replay.config.replay.ground_truth_max_gap));
+    matchFilterErrors(result);
+    return result;
+  }
   smoother::Smoother s(options.smoother);
   for (const auto& [stamp, state] : f.fused_states) s.addGuess(stamp, state);
   for (const auto& [source, pose] : f.filter_poses) s.addPose(source, pose);
@@ -46,14 +116,9 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   if (registry)
     for (std::size_t i = 0; i < r.calibrations.size() && i < registry->rsus().size(); ++i) result.calibrations[registry->rsus()[i].id] = r.calibrations[i];
   result.states = r.states;
-  for (const smoother::SmoothedState& st : r.states) {
-    io::TrajectoryPoint p;
-    p.stamp = st.stamp;
-    p.pose.position = {st.state[0], st.state[1], 0.0};
-    p.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, st.state[2] + st.state[3]);  // heading, as the filter gives it
-    result.smoothed.push_back(p);
-  }
+  for (const smoother::SmoothedState& st : r.states) result.smoothed.push_back(pointOf(st));
   result.errors = evaluate(result.smoothed, f.ground_truth, fromSeconds(options.replay.config.replay.ground_truth_max_gap));
+  matchFilterErrors(result);
   return result;
 }
 
@@ -94,7 +159,9 @@ std::string SmoothResult::summaryJson(const std::string& log) const {
   j["log"] = log;
   j["smoothed"] = {{"file", "smoothed.tum"}, {"states", smoothed.size()}};
   j["position_error"] = errorJson(errors, "error.csv");
-  j["filter_position_error"] = errorJson(filter.errors, "error.csv");
+  j["filter_position_error"] = errorJson(filter_errors_matched, "error.csv");
+  if (fixed_lag)
+    j["fixed_lag"] = {{"window_s", fixed_lag->window}, {"step_s", fixed_lag->step}, {"windows", fixed_lag->windows}};
   auto& down = j["down_weighted"] = nlohmann::ordered_json::array();
   for (const smoother::DownWeighted& d : summary.down_weighted)
     down.push_back({{"source", d.source}, {"stamp", formatSeconds(d.stamp)}, {"mahalanobis", d.mahalanobis}, {"weight", d.weight}});

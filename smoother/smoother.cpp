@@ -132,6 +132,22 @@ struct CalibratedFixResidual {
   }
 };
 
+struct StatePrior {
+  Vector6d mean;
+  Matrix6d whitening;  ///< L^-1 of its covariance
+  template <typename T>
+  bool operator()(const T* s, T* r) const {
+    T e[6];
+    for (int j = 0; j < 6; ++j) e[j] = s[j] - mean[j];
+    e[2] = wrapped(e[2]);
+    for (int i = 0; i < 6; ++i) {
+      r[i] = T(0.0);
+      for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
+    }
+    return true;
+  }
+};
+
 struct YawBiasPrior {
   double inverse_sigma;
   template <typename T>
@@ -198,8 +214,14 @@ struct CalibratedRsu {
   bool clock;
 };
 
+struct StoredPrior {
+  Stamp stamp;
+  StatePrior prior;
+};
+
 struct Smoother::Impl {
   SmootherOptions options;
+  std::vector<StoredPrior> priors;
   std::vector<CalibratedRsu> calibrated;
   std::vector<StoredPose> poses;
   std::vector<StoredTwist> twists;
@@ -286,6 +308,14 @@ void Smoother::calibrateRsu(const std::string& source, const Eigen::Vector2d& su
   impl_->calibrated.push_back({source, surveyed_position, clock});
 }
 
+bool Smoother::addPrior(Stamp stamp, const Vector6d& state, const Matrix6d& covariance) {
+  if (!state.allFinite() || !covariance.allFinite()) return false;
+  const Eigen::LLT<Matrix6d> llt(0.5 * (covariance + covariance.transpose()));
+  if (llt.info() != Eigen::Success) return false;
+  impl_->priors.push_back({stamp, {state, llt.matrixL().solve(Matrix6d::Identity())}});
+  return true;
+}
+
 void Smoother::addGuess(Stamp stamp, const Vector6d& state) {
   if (state.allFinite()) impl_->guesses[stamp] = state;
 }
@@ -312,8 +342,17 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
   for (std::size_t k = 0; k + 1 < n; ++k)
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<MotionResidual, 6, 6, 6>(new MotionResidual{dt, inverse_sigma}), nullptr,
                              blockOf(k), blockOf(k + 1));
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YawBiasPrior, 1, 6>(new YawBiasPrior{1.0 / std::sqrt(o.initial_yaw_bias_variance)}),
-                           nullptr, blockOf(0));
+  // A state prior (a window's start) replaces the weak pull of the yaw bias to zero.
+  bool prior_at_start = false;
+  for (const StoredPrior& p : impl_->priors) {
+    if (p.stamp < first || p.stamp > last) continue;
+    const std::size_t k = std::min(n - 1, static_cast<std::size_t>((p.stamp - first) / step));
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<StatePrior, 6, 6>(new StatePrior(p.prior)), nullptr, blockOf(k));
+    prior_at_start = prior_at_start || k == 0;
+  }
+  if (!prior_at_start)
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YawBiasPrior, 1, 6>(new YawBiasPrior{1.0 / std::sqrt(o.initial_yaw_bias_variance)}),
+                             nullptr, blockOf(0));
 
   struct Added {
     ceres::ResidualBlockId id;

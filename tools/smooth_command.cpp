@@ -30,7 +30,7 @@ void writeErrorPlot(const SmoothResult& r, const std::string& path) {
     return s;
   };
   const Stamp origin = r.filter.errors.empty() ? 0 : r.filter.errors.front().stamp;
-  plot.series.push_back(series(r.filter.errors, "filter", "#ff7f0e", origin));
+  plot.series.push_back(series(r.filter_errors_matched, "filter", "#ff7f0e", origin));
   plot.series.push_back(series(r.errors, "smoother", "#1f77b4", origin));
   writeSvg(path, plot);
 }
@@ -47,6 +47,10 @@ void addSmoothCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
   static bool calibrate = false;
+  static double window = 0.0, window_step = 0.5;
+  cmd->add_option("--window", window, "fixed-lag mode: a window of this many seconds behind the filter (0 = the whole log at once)")
+      ->capture_default_str();
+  cmd->add_option("--window-step", window_step, "how far the window moves each time, s")->capture_default_str();
   cmd->add_flag("--calibrate-rsus", calibrate,
                 "estimate each RSU's survey and clock offsets with the trajectory; writes rsu_calibrated.yaml for the next drives");
   cmd->callback([] {
@@ -56,6 +60,8 @@ void addSmoothCommand(CLI::App& app) {
     if (!registry.empty()) options.replay.registry = rsu_client::RsuRegistry::load(registry);
     options.smoother = smootherOptionsFor(options.replay.config.fusion);
     options.calibrate_rsus = calibrate;
+    options.window = window;
+    options.window_step = window_step;
     ProgressBar progress("filtering");
     options.replay.progress = [&](double f) { progress.update(f); };
     const SmoothResult r = smoothLog(log, options);
@@ -83,13 +89,17 @@ void addSmoothCommand(CLI::App& app) {
         }
       }
     }
-    const nlohmann::ordered_json timing = {{"replay_wall_s", r.filter.wall_seconds}, {"smoother_wall_s", r.wall_seconds},
-                                           {"solver_s", r.summary.seconds}};
+    nlohmann::ordered_json timing = {{"replay_wall_s", r.filter.wall_seconds}, {"smoother_wall_s", r.wall_seconds},
+                                     {"solver_s", r.summary.seconds}};
+    if (r.fixed_lag) {
+      timing["fixed_lag_mean_solve_s"] = r.fixed_lag->mean_solve_seconds;
+      timing["fixed_lag_max_solve_s"] = r.fixed_lag->max_solve_seconds;
+    }
     std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
     if (!r.errors.empty()) {
       std::ofstream csv(out_dir + "/error.csv");
       csv << "stamp_s,estimator,error_m,along_m,across_m\n";
-      for (const ErrorSample& e : r.filter.errors) csv << formatSeconds(e.stamp) << ",filter," << e.error << "," << e.along << "," << e.across << "\n";
+      for (const ErrorSample& e : r.filter_errors_matched) csv << formatSeconds(e.stamp) << ",filter," << e.error << "," << e.along << "," << e.across << "\n";
       for (const ErrorSample& e : r.errors) csv << formatSeconds(e.stamp) << ",smoother," << e.error << "," << e.along << "," << e.across << "\n";
       writeErrorPlot(r, out_dir + "/error.svg");
     }
@@ -98,6 +108,10 @@ void addSmoothCommand(CLI::App& app) {
     std::printf("  smoothed %.1f s of log in %.2f s (solver %.2f s); %zu measurements down-weighted by the robust loss\n",
                 toSeconds(r.smoothed.back().stamp - r.smoothed.front().stamp), r.wall_seconds, r.summary.seconds,
                 r.summary.down_weighted.size());
+    if (r.fixed_lag)
+      std::printf("  fixed lag: %d windows of %.1f s every %.2f s; each solved in %.1f ms on average, %.1f ms at most (the latency it adds)\n",
+                  r.fixed_lag->windows, r.fixed_lag->window, r.fixed_lag->step, 1e3 * r.fixed_lag->mean_solve_seconds,
+                  1e3 * r.fixed_lag->max_solve_seconds);
     for (std::size_t i = 0; i < r.summary.down_weighted.size() && i < 5; ++i) {
       const auto& d = r.summary.down_weighted[i];
       std::printf("    %s stamped %s: %.1f sigma, weight %.3f\n", d.source.c_str(), formatSeconds(d.stamp).c_str(), d.mahalanobis, d.weight);
@@ -115,7 +129,7 @@ void addSmoothCommand(CLI::App& app) {
       std::printf("  wrote %s/rsu_calibrated.yaml: the registry with the calibrations found, for the next drives\n", out_dir.c_str());
     }
     if (!r.errors.empty()) {
-      const ErrorStats f = errorStats(r.filter.errors), s = errorStats(r.errors);
+      const ErrorStats f = errorStats(r.filter_errors_matched), s = errorStats(r.errors);
       std::printf("  position error vs ground truth: filter mean %.4f m (RMSE %.4f), smoother mean %.4f m (RMSE %.4f): %.2fx\n", f.mean,
                   f.rmse, s.mean, s.rmse, f.mean > 0 ? s.mean / f.mean : 0.0);
     } else {

@@ -26,3 +26,11 @@ grep -q 'Termination: CONVERGENCE' "$work/smooth.txt" || { echo "FAIL: the smoot
 read -r filter smoothed < <(sed -n 's/.*filter mean \([0-9.]*\) m .*smoother mean \([0-9.]*\) m .*/\1 \2/p' "$work/smooth.txt")
 awk -v f="$filter" -v s="$smoothed" 'BEGIN { exit !(s <= 0.8 * f) }' || { echo "FAIL: smoother $smoothed m against filter $filter m"; exit 1; }
 echo "smoothed: $smoothed m against the filter's $filter m"
+
+# Fixed lag: two-second windows behind the filter, each from the filter's state at its start, must not
+# be worse than the filter they follow.
+"$coloc" smooth "$work/a/log" --map "$work/a/map" --config "$work/a/fuse.yaml" --window 2 --out "$work/fixed_lag" | tee "$work/fixed_lag.txt"
+grep -q 'fixed lag: [1-9][0-9]* windows of 2.0 s' "$work/fixed_lag.txt" || { echo "FAIL: no fixed-lag windows"; exit 1; }
+read -r filter lagged < <(sed -n 's/.*filter mean \([0-9.]*\) m .*smoother mean \([0-9.]*\) m .*/\1 \2/p' "$work/fixed_lag.txt")
+awk -v f="$filter" -v s="$lagged" 'BEGIN { exit !(s <= f) }' || { echo "FAIL: fixed lag $lagged m against the filter's $filter m"; exit 1; }
+echo "fixed lag: $lagged m against the filter's $filter m"

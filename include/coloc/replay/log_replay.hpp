@@ -56,6 +56,7 @@ struct ReplayResult {
   std::vector<std::pair<std::string, PoseMeasurement>> filter_poses;
   std::vector<std::pair<std::string, TwistMeasurement>> filter_twists;
   std::vector<std::pair<Stamp, Vector6d>> fused_states;
+  std::vector<Matrix6d> fused_state_covariances;  ///< beside fused_states
   double speed_scale = 1.0;           ///< the odometry's speed scale learned from NDT
   double speed_scale_distance = 0.0;  ///< m of travel it was learned over
 

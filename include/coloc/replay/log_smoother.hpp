@@ -4,6 +4,7 @@
 // the filter's states as its first guess), then every pose and twist solved for at once by the Ceres
 // smoother, and both trajectories scored against the log's ground truth.
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,18 @@ struct SmoothOptions {
   /// Estimate each registered RSU's survey and clock offsets with the trajectory (its fixes must be
   /// anchored by NDT or another pose source).
   bool calibrate_rsus = false;
+  /// Fixed-lag mode: a window of this many seconds slides behind the filter, `window_step` at a time,
+  /// starting from the filter's state and covariance at its start, and gives the states of its newest
+  /// step: what a vehicle running it behind the filter would have. 0: one batch over the whole log.
+  double window = 0.0;
+  double window_step = 0.5;
+};
+
+/// What the fixed-lag mode cost: how long each window took to solve (the latency it adds).
+struct FixedLagReport {
+  double window = 0.0, step = 0.0;
+  int windows = 0;
+  double mean_solve_seconds = 0.0, max_solve_seconds = 0.0;
 };
 
 /// The smoother's settings that match a filter configuration: tick rate, process noise, yaw-bias
@@ -35,6 +48,8 @@ struct SmoothResult {
   double wall_seconds = 0.0;                   ///< the smoothing alone
   /// Per RSU id, with calibrate_rsus. Observable ones can go into the next drives' registry.
   std::map<std::string, smoother::RsuCalibration> calibrations;
+  std::optional<FixedLagReport> fixed_lag;     ///< in fixed-lag mode
+  std::vector<ErrorSample> filter_errors_matched;  ///< the filter's errors at the stamps the smoother gave
   rsu_client::RsuRegistry registry;            ///< the registry used; `calibratedRegistry` adds the findings
 
   /// The registry with each observable calibration as the RSU's `calibration` entry, added to what it

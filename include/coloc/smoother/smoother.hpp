@@ -95,6 +95,9 @@ class Smoother {
   /// A first guess of the state at a stamp (the filter's estimates, say); states between guesses are
   /// interpolated, and the first guess also anchors a weak prior on the yaw bias.
   void addGuess(Stamp stamp, const Vector6d& state);
+  /// A prior on the state at `stamp` (a fixed-lag window's start: what the filter or an earlier window
+  /// knew there). Its covariance must be positive definite on the six states.
+  bool addPrior(Stamp stamp, const Vector6d& state, const Matrix6d& covariance);
   /// Estimates the survey and clock offsets of the RSU whose fixes come as `source`, jointly with the
   /// trajectory: its fixes are corrected by them before they are compared with the state. Other pose
   /// sources (NDT) anchor the trajectory; without them nothing here is observable, and is said so.
