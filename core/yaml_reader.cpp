@@ -1,6 +1,8 @@
 #include "coloc/core/yaml_reader.hpp"
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "coloc/core/config_error.hpp"
 
@@ -16,6 +18,14 @@ std::string shortNumber(double v) {
 }
 
 }  // namespace
+
+std::string YamlReader::readFile(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the " + what);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 YAML::Node YamlReader::parse(const std::string& text) const {
   try {

@@ -6,7 +6,7 @@
 #include <unordered_map>
 
 #include "coloc/core/error.hpp"
-#include "chi_square.hpp"
+#include "coloc/core/chi_square.hpp"
 #include "measurement_record.hpp"
 #include "state_history.hpp"
 

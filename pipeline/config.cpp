@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <type_traits>
@@ -353,11 +352,7 @@ Config parseConfig(const std::string& yaml_text, const std::string& source_name)
 }
 
 Config loadConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the config file");
-  std::stringstream text;
-  text << in.rdbuf();
-  Config config = parseConfig(text.str(), path);
+  Config config = parseConfig(YamlReader::readFile(path, "config file"), path);
   namespace fs = std::filesystem;
   if (!config.rsu.registry.empty() && fs::path(config.rsu.registry).is_relative())
     config.rsu.registry = (fs::path(path).parent_path() / config.rsu.registry).lexically_normal().string();

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "coloc/core/error.hpp"
+#include "error_json.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 
 namespace coloc::replay {
@@ -121,18 +122,6 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   matchFilterErrors(result);
   return result;
 }
-
-namespace {
-
-nlohmann::ordered_json errorJson(const std::vector<ErrorSample>& errors, const char* file) {
-  if (errors.empty()) return nullptr;
-  const ErrorStats s = errorStats(errors);
-  return {{"samples", errors.size()}, {"mean_m", s.mean},   {"rmse_m", s.rmse},
-          {"max_m", s.max},           {"along_mean_m", s.along_mean}, {"across_mean_m", s.across_mean},
-          {"file", file}};
-}
-
-}  // namespace
 
 rsu_client::RsuRegistry SmoothResult::calibratedRegistry() const {
   std::vector<rsu_client::RsuInfo> rsus = registry.rsus();

@@ -7,6 +7,7 @@
 #include "coloc/core/error.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "coloc/pipeline/report_json.hpp"
+#include "error_json.hpp"
 
 namespace coloc::replay {
 
@@ -38,21 +39,10 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
   }
   j["sources"] = nlohmann::ordered_json::parse(pipeline::sourcesJson(sources));
   j["fused"] = {{"file", "fused.tum"}, {"poses", fused.size()}, {"first_stamp", formatSeconds(first_stamp)}, {"last_stamp", formatSeconds(last_stamp)}};
-  if (!errors.empty()) {
-    const ErrorStats s = errorStats();
-    j["position_error"] = {{"samples", errors.size()}, {"mean_m", s.mean},   {"rmse_m", s.rmse},
-                           {"max_m", s.max},         {"along_mean_m", s.along_mean}, {"across_mean_m", s.across_mean},
-                           {"file", "error.csv"}};
-  } else {
-    j["position_error"] = nullptr;
-  }
+  j["position_error"] = errorJson(errors, "error.csv");
   if (!input_errors.empty()) {
     auto& inputs = j["input_error"] = nlohmann::ordered_json::object();
-    for (const auto& [source, samples] : input_errors) {
-      const ErrorStats s = replay::errorStats(samples);
-      inputs[source] = {{"samples", samples.size()}, {"mean_m", s.mean},   {"rmse_m", s.rmse},
-                        {"max_m", s.max},             {"along_mean_m", s.along_mean}, {"across_mean_m", s.across_mean}};
-    }
+    for (const auto& [source, samples] : input_errors) inputs[source] = errorJson(samples);
     inputs["file"] = "input_error.csv";
   }
   if (ndt_used) {

@@ -39,38 +39,34 @@ RsuFix corrected(const RsuFix& fix, const RsuInfo& rsu) {
   return out;
 }
 
+// A refusal: counted, and said with the fix and the reason.
+FixVerdict rejected(const RsuFix& fix, FixRejection reason, const std::string& why, std::uint64_t& counter) {
+  ++counter;
+  FixVerdict v;
+  v.rejection = reason;
+  std::ostringstream out;
+  out << "fix from '" << fix.rsu_id << "' stamped " << formatSeconds(fix.stamp) << " rejected (" << toString(reason) << "): " << why;
+  v.detail = out.str();
+  return v;
+}
+
 }  // namespace
 
-FixVerdict FixChecker::check(const RsuFix& received, Stamp now) {
-  const RsuFix& fix = received;
+FixVerdict FixChecker::check(const RsuFix& fix, Stamp now) {
   FixCounters& c = counters_[fix.rsu_id];
   ++c.received;
-  FixVerdict v;
-  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) {
-    ++counter;
-    v.rejection = reason;
-    std::ostringstream out;
-    out << "fix from '" << fix.rsu_id << "' stamped " << formatSeconds(fix.stamp) << " rejected (" << toString(reason) << "): " << why;
-    v.detail = out.str();
-    return v;
-  };
+  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) { return rejected(fix, reason, why, counter); };
   const RsuInfo* rsu = registry_.find(fix.rsu_id);
   if (!rsu) return reject(FixRejection::kUnknownRsu, "no such RSU in the registry", c.unknown_rsu);
   if (!std::isfinite(fix.x) || !std::isfinite(fix.y) || (fix.yaw && !std::isfinite(*fix.yaw)))
     return reject(FixRejection::kNonFinite, "position or yaw is not finite", c.non_finite);
-  return checkKnown(rsu->calibration ? corrected(fix, *rsu) : fix, now, *rsu, c, v);
+  return checkKnown(rsu->calibration ? corrected(fix, *rsu) : fix, now, *rsu, c);
 }
 
-FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& known, FixCounters& c, FixVerdict& v) {
+FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& known, FixCounters& c) {
   const RsuInfo* rsu = &known;
-  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) {
-    ++counter;
-    v.rejection = reason;
-    std::ostringstream out;
-    out << "fix from '" << fix.rsu_id << "' stamped " << formatSeconds(fix.stamp) << " rejected (" << toString(reason) << "): " << why;
-    v.detail = out.str();
-    return v;
-  };
+  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) { return rejected(fix, reason, why, counter); };
+  FixVerdict v;
   const double distance = (Eigen::Vector2d(fix.x, fix.y) - rsu->position).norm();
   if (distance > rsu->coverage_radius) {
     std::ostringstream why;

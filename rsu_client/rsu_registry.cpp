@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -113,11 +112,7 @@ RsuRegistry RsuRegistry::parse(const std::string& yaml_text, const std::string& 
 }
 
 RsuRegistry RsuRegistry::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the RSU registry");
-  std::stringstream s;
-  s << in.rdbuf();
-  return parse(s.str(), path);
+  return parse(YamlReader::readFile(path, "RSU registry"), path);
 }
 
 RsuRegistry::RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement) {

@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -158,11 +157,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
 }
 
 Scenario loadScenario(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the scenario");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parseScenario(text.str(), path);
+  return parseScenario(YamlReader::readFile(path, "scenario"), path);
 }
 
 std::vector<TriangleMesh> Scenario::worldMeshes() const {

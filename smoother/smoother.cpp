@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 
+#include "coloc/core/chi_square.hpp"
 #include "coloc/core/error.hpp"
 
 namespace coloc::smoother {
@@ -186,27 +187,7 @@ const char* terminationName(ceres::TerminationType t) {
   return "?";
 }
 
-double chiSquareSurvival(int dof, double x) {
-  const double h = std::sqrt(0.5 * x);
-  switch (dof) {
-    case 1: return std::erfc(h);
-    case 2: return std::exp(-0.5 * x);
-    default: return std::erfc(h) + std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
-  }
-}
-
 }  // namespace
-
-double chiSquareQuantile(int dof, double alpha) {
-  if (dof < 1 || dof > 3) throw Error("chiSquareQuantile: dof must be 1, 2 or 3");
-  if (!(alpha > 0.0 && alpha < 1.0)) throw Error("chiSquareQuantile: alpha must be in (0, 1)");
-  double lo = 0.0, hi = 1000.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (chiSquareSurvival(dof, mid) > alpha ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
 
 struct CalibratedRsu {
   std::string source;
@@ -245,61 +226,62 @@ Smoother::~Smoother() = default;
 Smoother::Smoother(Smoother&&) noexcept = default;
 Smoother& Smoother::operator=(Smoother&&) noexcept = default;
 
+namespace {
+
+// The measured ones among `count` components (ROS 6x6 indices `index`, values `values`): a finite
+// positive variance and a finite value; +inf leaves a component out. A NaN or negative variance, or a
+// block that is not positive definite, refuses the whole measurement (nullopt), as the filter does.
+struct Measured {
+  int m = 0;
+  int which[3];  ///< positions in `index` of the measured components
+  Eigen::Matrix3d whitening = Eigen::Matrix3d::Zero();  ///< L^-1 of their covariance, upper-left m x m
+};
+
+std::optional<Measured> measured(const Matrix6d& covariance, const int* index, const double* values, int count) {
+  Measured out;
+  for (int k = 0; k < count; ++k) {
+    const double v = covariance(index[k], index[k]);
+    if (std::isnan(v) || v < 0.0) return std::nullopt;
+    if (std::isfinite(v) && v > 0.0 && std::isfinite(values[k])) out.which[out.m++] = k;
+  }
+  if (out.m == 0) return std::nullopt;
+  Eigen::MatrixXd block(out.m, out.m);
+  for (int i = 0; i < out.m; ++i)
+    for (int j = 0; j < out.m; ++j) block(i, j) = covariance(index[out.which[i]], index[out.which[j]]);
+  const Eigen::LLT<Eigen::MatrixXd> llt(block);
+  if (!block.allFinite() || llt.info() != Eigen::Success) return std::nullopt;
+  out.whitening.topLeftCorner(out.m, out.m) = llt.matrixL().solve(Eigen::MatrixXd::Identity(out.m, out.m));
+  return out;
+}
+
+}  // namespace
+
 bool Smoother::addPose(const std::string& source, const PoseMeasurement& measurement) {
+  const int index[3] = {0, 1, 5};  // x, y, yaw in the ROS 6x6 order
+  const double values[3] = {measurement.pose.position.x(), measurement.pose.position.y(), rollPitchYaw(measurement.pose.orientation)[2]};
+  const std::optional<Measured> got = measured(measurement.covariance, index, values, 3);
+  if (!got) return false;
   StoredPose p;
   p.source = source;
   p.stamp = measurement.stamp;
-  p.m = 0;
-  const double yaw = rollPitchYaw(measurement.pose.orientation)[2];
-  const int covariance_index[3] = {0, 1, 5};  // x, y, yaw in the ROS 6x6 order
-  const double values[3] = {measurement.pose.position.x(), measurement.pose.position.y(), yaw};
-  int used[3];
-  for (int k = 0; k < 3; ++k) {
-    const double v = measurement.covariance(covariance_index[k], covariance_index[k]);
-    if (std::isfinite(v) && v > 0.0 && std::isfinite(values[k])) {
-      used[p.m] = covariance_index[k];
-      p.component[p.m] = k;
-      p.value[p.m] = values[k];
-      ++p.m;
-    }
-  }
-  if (p.m == 0) return false;
-  Eigen::Matrix3d block = Eigen::Matrix3d::Identity();
-  for (int i = 0; i < p.m; ++i)
-    for (int j = 0; j < p.m; ++j) block(i, j) = measurement.covariance(used[i], used[j]);
-  const Eigen::LLT<Eigen::MatrixXd> llt(block.topLeftCorner(p.m, p.m));
-  if (llt.info() != Eigen::Success || !block.topLeftCorner(p.m, p.m).allFinite()) return false;
-  p.whitening = Eigen::Matrix3d::Zero();
-  p.whitening.topLeftCorner(p.m, p.m) = llt.matrixL().solve(Eigen::MatrixXd::Identity(p.m, p.m));
+  p.m = got->m;
+  for (int j = 0; j < p.m; ++j) p.component[j] = got->which[j], p.value[j] = values[got->which[j]];
+  p.whitening = got->whitening;
   impl_->poses.push_back(p);
   return true;
 }
 
 bool Smoother::addTwist(const std::string& source, const TwistMeasurement& measurement) {
+  const int index[2] = {0, 5};  // vx, wz
+  const double values[2] = {measurement.linear.x(), measurement.angular.z()};
+  const std::optional<Measured> got = measured(measurement.covariance, index, values, 2);
+  if (!got) return false;
   StoredTwist t;
   t.source = source;
   t.stamp = measurement.stamp;
-  t.m = 0;
-  const int covariance_index[2] = {0, 5};
-  const double values[2] = {measurement.linear.x(), measurement.angular.z()};
-  int used[2];
-  for (int k = 0; k < 2; ++k) {
-    const double v = measurement.covariance(covariance_index[k], covariance_index[k]);
-    if (std::isfinite(v) && v > 0.0 && std::isfinite(values[k])) {
-      used[t.m] = covariance_index[k];
-      t.component[t.m] = k == 0 ? 4 : 5;
-      t.value[t.m] = values[k];
-      ++t.m;
-    }
-  }
-  if (t.m == 0) return false;
-  Eigen::Matrix2d block = Eigen::Matrix2d::Identity();
-  for (int i = 0; i < t.m; ++i)
-    for (int j = 0; j < t.m; ++j) block(i, j) = measurement.covariance(used[i], used[j]);
-  const Eigen::LLT<Eigen::MatrixXd> llt(block.topLeftCorner(t.m, t.m));
-  if (llt.info() != Eigen::Success || !block.topLeftCorner(t.m, t.m).allFinite()) return false;
-  t.whitening = Eigen::Matrix2d::Zero();
-  t.whitening.topLeftCorner(t.m, t.m) = llt.matrixL().solve(Eigen::MatrixXd::Identity(t.m, t.m));
+  t.m = got->m;
+  for (int j = 0; j < t.m; ++j) t.component[j] = got->which[j] == 0 ? 4 : 5, t.value[j] = values[got->which[j]];
+  t.whitening = got->whitening.topLeftCorner<2, 2>();
   impl_->twists.push_back(t);
   return true;
 }

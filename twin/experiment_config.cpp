@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "builtin_scenarios.hpp"
@@ -73,20 +72,16 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
 }
 
 ExperimentConfig loadExperimentConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot read the experiment file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseExperimentConfig(text.str(), path);
+  return parseExperimentConfig(YamlReader::readFile(path, "experiment file"), path);
 }
 
 std::string scenarioText(const std::string& site) {
   if (const char* builtin = builtinScenario(site)) return builtin;
-  std::ifstream in(site);
-  if (!in) throw Error(site + ": neither a built-in scenario (site_a, site_b) nor a readable scenario file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  try {
+    return YamlReader::readFile(site, "scenario file");
+  } catch (const Error&) {
+    throw Error(site + ": neither a built-in scenario (site_a, site_b) nor a readable scenario file");
+  }
 }
 
 }  // namespace coloc::twin

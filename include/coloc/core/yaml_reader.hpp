@@ -17,6 +17,9 @@ class YamlReader {
   explicit YamlReader(std::string source) : source_(std::move(source)) {}
   const std::string& source() const { return source_; }
 
+  /// A configuration file's whole text; throws coloc::Error "PATH: cannot open the WHAT" if it cannot.
+  static std::string readFile(const std::string& path, const std::string& what);
+
   /// Parses a document; a syntax error names the file and line.
   YAML::Node parse(const std::string& text) const;
 

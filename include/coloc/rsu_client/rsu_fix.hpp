@@ -53,7 +53,7 @@ class FixChecker {
 
  private:
   /// The checks after the RSU is known and its calibration applied.
-  FixVerdict checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& rsu, FixCounters& counters, FixVerdict& verdict);
+  FixVerdict checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& rsu, FixCounters& counters);
   RsuRegistry registry_;
   FixCheckConfig config_;
   std::map<std::string, FixCounters> counters_;

@@ -88,7 +88,7 @@ class Smoother {
 
   /// A pose measurement; x, y and yaw enter where their variance is finite (z, roll and pitch are not
   /// in the planar state). Returns false, leaving the problem unchanged, for a measurement with no
-  /// finite x, y or yaw variance or a covariance that is not positive definite on them.
+  /// finite x, y or yaw variance, a NaN or negative one, or a covariance not positive definite on them.
   bool addPose(const std::string& source, const PoseMeasurement& measurement);
   /// A twist; vx and wz enter where their variance is finite.
   bool addTwist(const std::string& source, const TwistMeasurement& measurement);
@@ -111,8 +111,5 @@ class Smoother {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-/// The chi-square quantile for `dof` degrees of freedom (1-3) at probability 1 - alpha.
-double chiSquareQuantile(int dof, double alpha);
 
 }  // namespace coloc::smoother

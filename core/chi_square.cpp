@@ -1,10 +1,10 @@
-#include "chi_square.hpp"
+#include "coloc/core/chi_square.hpp"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace coloc::fusion {
+namespace coloc {
 
 double chiSquareSurvival(int dof, double x) {
   if (dof < 1 || dof > 6) throw std::invalid_argument("chi-square dof must be 1..6, got " + std::to_string(dof));
@@ -42,4 +42,4 @@ double chiSquareQuantile(int dof, double alpha) {
   return 0.5 * (lo + hi);
 }
 
-}  // namespace coloc::fusion
+}  // namespace coloc

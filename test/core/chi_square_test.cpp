@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
-#include "chi_square.hpp"
+#include "coloc/core/chi_square.hpp"
 
-namespace coloc::fusion {
+namespace coloc {
 namespace {
 
 TEST(ChiSquare, QuantileAtAutowareAlphaGivesItsGateValues) {
@@ -30,4 +30,4 @@ TEST(ChiSquare, RejectsDimensionsAndProbabilitiesOutOfRange) {
 }
 
 }  // namespace
-}  // namespace coloc::fusion
+}  // namespace coloc
