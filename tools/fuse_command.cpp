@@ -8,6 +8,7 @@
 
 #include "coloc/core/error.hpp"
 #include "commands.hpp"
+#include "log_options.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "progress.hpp"
 #include "coloc/replay/svg_plot.hpp"
@@ -113,25 +114,17 @@ void writePlots(const ReplayResult& r, const std::string& dir, const std::string
 
 void addFuseCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("fuse", "Fuse a recorded ROS 2 log (.mcap, .db3 or rosbag2 folder) and write the trajectory");
-  static std::string log, config_path, map, registry, out_dir = "coloc_out";
-  cmd->add_option("LOG", log, "the recording")->required();
-  cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`)")->check(CLI::ExistingFile);
-  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles): PointCloud2 topics then feed NDT");
-  cmd->add_option("--rsu-registry", registry, "RSU registry (YAML): /rsu/<id>/fix topics of its RSUs pass its checks (default: rsu.registry of the config)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
+  static LogOptions o{"", "", "", "", "coloc_out"};
+  addLogOptions(cmd, o);
   cmd->callback([] {
-    ReplayOptions options;
-    if (!config_path.empty()) options.config = pipeline::loadConfig(config_path);
-    options.map = map;
-    if (!registry.empty()) options.registry = rsu_client::RsuRegistry::load(registry);
+    const std::string& log = o.log;
+    const std::string& out_dir = o.out;
+    ReplayOptions options = replayOptions(o);
     ProgressBar progress("fusing");
     options.progress = [&](double f) { progress.update(f); };
     const ReplayResult result = replayLog(log, options);
     progress.finish();
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    createOutputFolder(out_dir);
     // The header names no file, so the same data in another storage format gives the same bytes.
     io::writeTumTrajectory(out_dir + "/fused.tum", result.fused,
                            "coloc fused trajectory\nt x y z qx qy qz qw (t: header-stamp clock, s)");

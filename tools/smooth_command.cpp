@@ -10,6 +10,7 @@
 #include "coloc/replay/log_smoother.hpp"
 #include "coloc/replay/svg_plot.hpp"
 #include "commands.hpp"
+#include "log_options.hpp"
 #include "progress.hpp"
 
 namespace coloc::tools {
@@ -39,13 +40,8 @@ void writeErrorPlot(const SmoothResult& r, const std::string& path) {
 
 void addSmoothCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("smooth", "Smooth a recorded log with every measurement at once (Ceres), beside the filter");
-  static std::string log, config_path, map, registry, out_dir = "coloc_smooth";
-  cmd->add_option("LOG", log, "the recording")->required();
-  cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`)")->check(CLI::ExistingFile);
-  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles): PointCloud2 topics then feed NDT");
-  cmd->add_option("--rsu-registry", registry, "RSU registry (YAML) whose checks the fixes pass (default: rsu.registry of the config)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--out", out_dir, "output folder (created)")->capture_default_str();
+  static LogOptions o{"", "", "", "", "coloc_smooth"};
+  addLogOptions(cmd, o);
   static bool calibrate = false;
   static double window = 0.0, window_step = 0.5;
   cmd->add_option("--window", window, "fixed-lag mode: a window of this many seconds behind the filter (0 = the whole log at once)")
@@ -54,10 +50,10 @@ void addSmoothCommand(CLI::App& app) {
   cmd->add_flag("--calibrate-rsus", calibrate,
                 "estimate each RSU's survey and clock offsets with the trajectory; writes rsu_calibrated.yaml for the next drives");
   cmd->callback([] {
+    const std::string& log = o.log;
+    const std::string& out_dir = o.out;
     SmoothOptions options;
-    if (!config_path.empty()) options.replay.config = pipeline::loadConfig(config_path);
-    options.replay.map = map;
-    if (!registry.empty()) options.replay.registry = rsu_client::RsuRegistry::load(registry);
+    options.replay = replayOptions(o);
     options.smoother = smootherOptionsFor(options.replay.config.fusion);
     options.calibrate_rsus = calibrate;
     options.window = window;
@@ -66,9 +62,7 @@ void addSmoothCommand(CLI::App& app) {
     options.replay.progress = [&](double f) { progress.update(f); };
     const SmoothResult r = smoothLog(log, options);
     progress.finish();
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    createOutputFolder(out_dir);
     io::writeTumTrajectory(out_dir + "/smoothed.tum", r.smoothed, "coloc smoothed trajectory\nt x y z qx qy qz qw (t: header-stamp clock, s)");
     std::ofstream(out_dir + "/summary.json") << r.summaryJson(log);
     {

@@ -1,0 +1,22 @@
+#pragma once
+// The options of the commands that replay a recorded log (fuse, smooth): the log, its configuration,
+// map and RSU registry, and the output folder.
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "coloc/replay/log_replay.hpp"
+
+namespace coloc::tools {
+
+struct LogOptions {
+  std::string log, config, map, registry;
+  std::string out;  ///< its default is set before addLogOptions
+};
+
+void addLogOptions(CLI::App* cmd, LogOptions& o);
+/// The replay the options describe (config, map, registry loaded; throws coloc::Error naming a bad file).
+replay::ReplayOptions replayOptions(const LogOptions& o);
+/// Creates the output folder or throws coloc::Error saying why not.
+void createOutputFolder(const std::string& dir);
+
+}  // namespace coloc::tools
