@@ -90,7 +90,7 @@ class WriterMatches : public dds::DataWriterListener {
 struct DdsNode::Writer::Impl {
   dds::DataWriter* writer = nullptr;
   WriterMatches listener;
-  std::mutex mutex;  // DataWriter::write is thread-safe; the staging copy is not
+  std::mutex mutex;  // DataWriter::write is thread-safe; the staging copy of a raw buffer is not
   Bytes staging;
 };
 
@@ -106,6 +106,12 @@ bool DdsNode::Writer::waitForAcknowledgments(double timeout_seconds) {
   const auto whole = static_cast<std::int32_t>(timeout_seconds);
   const auto nanos = static_cast<std::uint32_t>((timeout_seconds - whole) * 1e9);
   return impl_->writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(whole, nanos)) == ReturnCode_t::RETCODE_OK;
+}
+
+bool DdsNode::Writer::write(const std::vector<std::uint8_t>& bytes) {
+  if (!impl_ || !impl_->writer) return false;
+  // DataWriter::write takes a non-const pointer but only serializes from it (SerializedType copies out).
+  return impl_->writer->write(const_cast<Bytes*>(&bytes));
 }
 
 int DdsNode::Writer::matchedReaders() const { return impl_ ? impl_->listener.matched.load() : 0; }

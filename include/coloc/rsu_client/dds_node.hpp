@@ -35,7 +35,8 @@ class DdsNode {
    public:
     /// Writes one serialized message (CDR with its 4-byte encapsulation header). False if DDS refused.
     bool write(const std::uint8_t* data, std::size_t size);
-    bool write(const std::vector<std::uint8_t>& bytes) { return write(bytes.data(), bytes.size()); }
+    /// The same without a copy: the vector is the sample.
+    bool write(const std::vector<std::uint8_t>& bytes);
     int matchedReaders() const;
     /// Reliable writers: waits until every matched reader acknowledged what was written (or the
     /// timeout passes; false then). A writer deleted earlier takes unacknowledged samples with it.
