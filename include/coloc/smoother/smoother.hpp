@@ -25,6 +25,10 @@ struct SmootherOptions {
   /// weight, so they get this much (small: the motion model's own error, not a source of freedom).
   double proc_stddev_position_c = 0.02;  ///< m/s
   double proc_stddev_yaw_bias_c = 1e-4;  ///< rad/s
+  /// Motion between states by the trapezoid rule (exact for constant acceleration); false: the filter's
+  /// forward step, its model exactly (the smoother then reproduces the filter's last state on a linear
+  /// problem).
+  bool trapezoid = true;
   double initial_yaw_bias_variance = 1e-4;  ///< rad^2, a prior pulling the bias to 0 (as the filter starts)
   /// Chance that a correct measurement is down-weighted: the Huber loss starts at the square root of
   /// the chi-square (1 - alpha) quantile of its dimension, where the filter's gate refuses.
