@@ -55,7 +55,9 @@ TEST(SmootherAndFilter, OnALinearGaussianDriveTheSmoothersLastStateIsTheFilters)
   for (int k = 0; k <= ticks; ++k) {
     const Stamp t = kStart + k * kTick;
     const double x = speed * k * 0.02;
-    if (k > 0) ASSERT_TRUE(!filter.advanceTo(t).rejected());
+    if (k > 0) {
+      ASSERT_TRUE(!filter.advanceTo(t).rejected());
+    }
     TwistMeasurement tw;
     tw.stamp = t;
     tw.linear = {speed + 0.1 * n01(rng), 0.0, 0.0};
