@@ -102,6 +102,10 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   }
   smoother::Smoother s(options.smoother);
   for (const auto& [stamp, state] : f.fused_states) s.addGuess(stamp, state);
+  // A configured initial pose is information the filter started from: the smoother starts from it too,
+  // as the filter's first state and covariance.
+  if (options.replay.config.pipeline.initial_pose && !f.fused_state_covariances.empty())
+    s.addPrior(f.fused_states.front().first, f.fused_states.front().second, f.fused_state_covariances.front());
   for (const auto& [source, pose] : f.filter_poses) s.addPose(source, pose);
   for (const auto& [source, twist] : f.filter_twists) s.addTwist(source, twist);
   std::optional<rsu_client::RsuRegistry> registry = options.replay.registry;

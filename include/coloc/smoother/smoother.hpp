@@ -3,8 +3,9 @@
 // the filter's tick rate with the filter's motion model (x, y, yaw, yaw bias, vx, wz) as motion
 // residuals weighted by its process noise; poses are residuals with their full covariance on the
 // components they measure (an infinite variance leaves its component out exactly), each at its own
-// stamp by propagating the state before it; twists likewise. A robust loss whose scale is the filter's
-// gate replaces hard gates, and what it down-weighted is reported. Ceres solves it; its summary and the
+// stamp by propagating the state before it; twists likewise. A Huber loss whose scale is the filter's
+// gate, then that gate applied with hindsight at the robust solution, replace the filter's hard gate,
+// and what they down-weighted or left out is reported. Ceres solves it; its summary and the
 // marginal covariances of the positions come back with the states. Depends on core and Ceres only.
 #include <memory>
 #include <optional>
@@ -31,7 +32,8 @@ struct SmootherOptions {
   bool trapezoid = true;
   double initial_yaw_bias_variance = 1e-4;  ///< rad^2, a prior pulling the bias to 0 (as the filter starts)
   /// Chance that a correct measurement is down-weighted: the Huber loss starts at the square root of
-  /// the chi-square (1 - alpha) quantile of its dimension, where the filter's gate refuses.
+  /// the chi-square (1 - alpha) quantile of its dimension, where the filter's gate refuses; a
+  /// measurement still beyond it at the robust solution is then left out and the problem solved again.
   double gate_alpha = 1e-10;
   bool robust = true;
   int max_iterations = 50;
@@ -44,7 +46,7 @@ struct DownWeighted {
   std::string source;
   Stamp stamp = 0;
   double mahalanobis = 0.0;  ///< sqrt of the whitened squared residual at the solution
-  double weight = 1.0;       ///< the loss's weight there (1 = full)
+  double weight = 1.0;       ///< the loss's weight there (1 = full, 0 = left out: beyond the gate)
 };
 
 struct SmootherSummary {
