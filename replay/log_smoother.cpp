@@ -51,6 +51,9 @@ void smoothFixedLag(const SmoothOptions& options, SmoothResult& result) {
   const Duration window = fromSeconds(options.window), step = fromSeconds(std::max(options.window_step, 1e-3));
   smoother::SmootherOptions o = options.smoother;
   o.covariances = false;  // a vehicle running behind the filter wants the states, now
+  // A window of a second or two is too short to measure the sources' noise in; it takes the
+  // covariances as given, as the filter does.
+  o.estimate_noise = false;
   const Stamp first = f.fused_states.front().first, last = f.fused_states.back().first;
   std::size_t start_index = 0;
   for (Stamp end = first + window; end <= last; end += step) {
@@ -155,6 +158,10 @@ std::string SmoothResult::summaryJson(const std::string& log) const {
   j["filter_position_error"] = errorJson(filter_errors_matched, "error.csv");
   if (fixed_lag)
     j["fixed_lag"] = {{"window_s", fixed_lag->window}, {"step_s", fixed_lag->step}, {"windows", fixed_lag->windows}};
+  if (!summary.noise.empty()) {
+    auto& noise = j["noise_scale"] = nlohmann::ordered_json::object();  // measured sd / the covariances' sd
+    for (const smoother::NoiseScale& n : summary.noise) noise[n.source] = n.scale;
+  }
   auto& down = j["down_weighted"] = nlohmann::ordered_json::array();
   for (const smoother::DownWeighted& d : summary.down_weighted)
     down.push_back({{"source", d.source}, {"stamp", formatSeconds(d.stamp)}, {"mahalanobis", d.mahalanobis}, {"weight", d.weight}});
@@ -169,7 +176,9 @@ std::string SmoothResult::summaryJson(const std::string& log) const {
                                   {"sd_dy_m", c.sd_dy},
                                   {"sd_dyaw_deg", c.sd_dyaw * 180.0 / M_PI},
                                   {"sd_clock_offset_ms", c.sd_clock_offset * 1e3},
-                                  {"observable", c.observable}};
+                                  {"observable", c.observable},
+                                  {"clock_observable", c.clock_observable},
+                                  {"fixes", c.fixes}};
       if (!c.note.empty()) o["note"] = c.note;
       cal[id] = o;
     }

@@ -309,6 +309,30 @@ void Smoother::addGuess(Stamp stamp, const Vector6d& state) {
 }
 
 SmootherResult Smoother::solve(Stamp first, Stamp last) const {
+  std::vector<bool> clock(impl_->calibrated.size());
+  for (std::size_t i = 0; i < clock.size(); ++i) clock[i] = impl_->calibrated[i].clock;
+  SmootherResult result = solveWith(first, last, clock);
+  // A drive at one speed along a straight road cannot tell an RSU's clock offset from an along-road
+  // survey offset (both move its fixes along the road alike). Then the rest is still determined: the
+  // clock is held at 0 and the survey offset absorbs its effect, which holds for drives at that speed.
+  bool retry = false;
+  for (std::size_t i = 0; i < clock.size(); ++i)
+    if (clock[i] && !result.calibrations[i].observable && result.calibrations[i].fixes > 0) clock[i] = false, retry = true;
+  if (!retry) return result;
+  SmootherResult held = solveWith(first, last, clock);
+  if (!held.summary.usable()) return result;
+  for (std::size_t i = 0; i < clock.size(); ++i) {
+    if (clock[i] || !impl_->calibrated[i].clock) continue;
+    RsuCalibration& c = held.calibrations[i];
+    c.clock_observable = false;
+    if (c.observable)
+      c.note = "the clock offset is not separable from the survey offset along the road on this drive (one speed, a straight road): held at 0, "
+               "its effect absorbed by the survey offset, which holds for drives at this speed";
+  }
+  return held;
+}
+
+SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bool>& clock) const {
   const SmootherOptions& o = impl_->options;
   if (impl_->guesses.empty()) throw Error("smoother: no first guess of the states (addGuess)");
   if (last <= first) throw Error("smoother: the span to smooth is empty");
@@ -361,8 +385,8 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
   // that a gross fix does not drag its neighbours (twists included) past the gate as well; see below.
   auto loss = [&](int m) -> std::pair<ceres::LossFunctionWrapper*, double> {
     const double delta2 = chiSquareQuantile(m, o.gate_alpha);
-    if (!o.robust) return {nullptr, delta2};
-    return {new ceres::LossFunctionWrapper(new ceres::CauchyLoss(std::sqrt(delta2)), ceres::TAKE_OWNERSHIP), delta2};
+    if (!o.robust && !o.estimate_noise) return {nullptr, delta2};
+    return {new ceres::LossFunctionWrapper(o.robust ? new ceres::CauchyLoss(std::sqrt(delta2)) : nullptr, ceres::TAKE_OWNERSHIP), delta2};
   };
   for (const StoredPose& p : impl_->poses) {
     if (p.stamp < first || p.stamp > last) continue;
@@ -388,7 +412,7 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
     ++result.summary.pose_residuals;
   }
   for (std::size_t i = 0; i < impl_->calibrated.size(); ++i)
-    if (!impl_->calibrated[i].clock && fixes_of[i] > 0) problem.SetManifold(calibration[i].data(), new ceres::SubsetManifold(4, {3}));
+    if (!clock[i] && fixes_of[i] > 0) problem.SetManifold(calibration[i].data(), new ceres::SubsetManifold(4, {3}));
   for (const StoredTwist& t : impl_->twists) {
     if (t.stamp < first || t.stamp > last || n < 2) continue;
     const std::size_t k = std::min(n - 2, static_cast<std::size_t>((t.stamp - first) / step));
@@ -417,33 +441,108 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
     for (double r : residuals) sum += r * r;
     return sum;
   };
+  // The chain's blocks, for the marginal covariances: states, then the calibrations with fixes.
+  std::vector<double*> state_blocks(n), global_blocks;
+  std::vector<std::size_t> global_rsu;  // which calibrated RSU each global block is
+  std::map<const double*, std::size_t> state_of;
+  for (std::size_t k = 0; k < n; ++k) state_blocks[k] = blockOf(k), state_of[blockOf(k)] = k;
+  auto collectGlobals = [&] {
+    global_blocks.clear();
+    global_rsu.clear();
+    for (std::size_t i = 0; i < impl_->calibrated.size(); ++i)
+      if (fixes_of[i] > 0) global_blocks.push_back(calibration[i].data()), global_rsu.push_back(i);
+  };
+
   const auto start = std::chrono::steady_clock::now();
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   result.summary.initial_cost = summary.initial_cost;
   result.summary.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  // The filter's gate, with hindsight: a measurement beyond it at the robust solution is left out, and
-  // the rest are solved again under a Huber loss at the gate (quadratic within it, as the filter weighs
-  // what passes its gate). A Huber loss from the start would bound a gross fix's pull but not end it:
-  // 1.8 m off with a 12 cm sigma, it pulled the track 3 cm back, and at 2 mm it dragged the twists
-  // around it past their gate too.
-  if (o.robust && summary.IsSolutionUsable()) {
+  // Each source's variance factor: what its covariances are off by, as the drive measures it.
+  std::map<std::string, double> factor;
+  auto factorOf = [&](const Added& a) {
+    const auto it = factor.find(*a.source);
+    return it == factor.end() ? 1.0 : it->second;
+  };
+  const int rounds = o.estimate_noise ? o.noise_rounds : 0;
+  for (int round = 0; (o.robust || rounds > 0) && summary.IsSolutionUsable(); ++round) {
+    // The filter's gate, with hindsight: a measurement beyond it at the robust solution is left out,
+    // and the rest are solved again under a Huber loss at the gate (quadratic within it, as the filter
+    // weighs what passes its gate), each source's covariance scaled by its factor. A Huber loss from
+    // the start would bound a gross fix's pull but not end it: 1.8 m off with a 12 cm sigma, it pulled
+    // the track 3 cm back, and at 2 mm it dragged the twists around it past their gate too.
     std::vector<Added> kept;
     for (const Added& a : added) {
-      const double sum = whitenedSquared(a);
-      if (sum <= a.threshold) {
-        a.loss->Reset(new ceres::HuberLoss(std::sqrt(a.threshold)), ceres::TAKE_OWNERSHIP);
+      const double f = factorOf(a), sum = whitenedSquared(a);
+      if (!o.robust || sum <= f * a.threshold) {
+        ceres::LossFunction* inner = o.robust ? new ceres::HuberLoss(std::sqrt(f * a.threshold)) : nullptr;
+        a.loss->Reset(new ceres::ScaledLoss(inner, 1.0 / f, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
         kept.push_back(a);
         continue;
       }
-      result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(sum), 0.0});
+      result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(sum / f), 0.0});
       problem.RemoveResidualBlock(a.id);
       if (a.rsu >= 0) --fixes_of[static_cast<std::size_t>(a.rsu)];
     }
     added = kept;
     ceres::Solve(solver, &problem, &summary);
     result.summary.iterations += static_cast<int>(summary.iterations.size()) - 1;
+    if (round >= rounds || !summary.IsSolutionUsable()) break;
+
+    // Variance components (Foerstner), made robust: a residual's squared whitened norm r^2 has the
+    // expectation f (m - tr(A Sigma A^T) / f), its redundancy, where A is its Jacobian on the states
+    // and Sigma their marginal covariance; the source's new factor is the median of r^2 / (redundancy
+    // / m) over the median of chi-square(m), so that the few misfits that the Huber loss bounds (a fix
+    // on the wrong corner) do not inflate it for all the good ones.
+    collectGlobals();
+    const ChainMarginals m = chainMarginals(problem, state_blocks, global_blocks, std::max(1, o.threads));
+    if (!m.ok) break;
+    struct Tally {
+      std::vector<double> normalised;  ///< r^2 / (redundancy / m)
+      int m = 0;
+    };
+    std::map<std::string, Tally> tally;
+    for (const Added& a : added) {
+      const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(a.id);
+      std::vector<double*> parameters;
+      problem.GetParameterBlocksForResidualBlock(a.id, &parameters);
+      const int rows = cost->num_residuals();
+      std::vector<double> residuals(static_cast<std::size_t>(rows));
+      std::vector<std::vector<double>> jacobian_storage(parameters.size());
+      std::vector<double*> jacobians(parameters.size());
+      for (std::size_t b = 0; b < parameters.size(); ++b) {
+        jacobian_storage[b].resize(static_cast<std::size_t>(rows * cost->parameter_block_sizes()[b]));
+        jacobians[b] = jacobian_storage[b].data();
+      }
+      cost->Evaluate(parameters.data(), residuals.data(), jacobians.data());
+      double hat = 0.0;
+      for (std::size_t b = 0; b < parameters.size(); ++b) {
+        const auto k = state_of.find(parameters[b]);
+        if (k == state_of.end()) continue;  // a calibration block: its share is small beside the states'
+        const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> J(jacobians[b], rows, 6);
+        hat += (J * m.states[k->second] * J.transpose()).trace();
+      }
+      double squares = 0.0;
+      for (double r : residuals) squares += r * r;
+      const double redundancy = (rows - hat / factorOf(a)) / rows;
+      if (redundancy < 0.05) continue;  // a residual its states follow almost entirely says little
+      Tally& t = tally[*a.source];
+      t.normalised.push_back(squares / redundancy);
+      t.m = std::max(t.m, rows);
+    }
+    bool changed = false;
+    for (auto& [source, t] : tally) {
+      if (static_cast<int>(t.normalised.size()) < o.noise_min_measurements) continue;
+      const auto middle = t.normalised.begin() + static_cast<std::ptrdiff_t>(t.normalised.size() / 2);
+      std::nth_element(t.normalised.begin(), middle, t.normalised.end());
+      const double updated = std::clamp(*middle / chiSquareQuantile(t.m, 0.5), 1e-4, 1e4);
+      double& f = factor.try_emplace(source, 1.0).first->second;
+      changed = changed || std::abs(updated / f - 1.0) > 0.05;
+      f = updated;
+    }
+    if (!changed) break;
   }
+  for (const auto& [source, f] : factor) result.summary.noise.push_back({source, std::sqrt(f)});
   result.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.summary.final_cost = summary.final_cost;
   result.summary.termination = terminationName(summary.termination_type);
@@ -453,17 +552,13 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
 
   // What the robust loss still weighs less than its covariance: whitened norms beyond the gate.
   for (const Added& a : added) {
-    const double sum = whitenedSquared(a);
+    const double f = factorOf(a), sum = whitenedSquared(a) / f;
     if (sum > a.threshold) result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(sum), std::sqrt(a.threshold / sum)});
   }
 
   // Marginal covariances of the states and of the calibrations, from the chain's structure (linear in
   // the drive's length; ceres::Covariance's sparse QR took 20 times the solve on a 90 s log).
-  std::vector<double*> state_blocks(n), global_blocks;
-  std::vector<std::size_t> global_rsu;  // which calibrated RSU each global block is
-  for (std::size_t k = 0; k < n; ++k) state_blocks[k] = blockOf(k);
-  for (std::size_t i = 0; i < impl_->calibrated.size(); ++i)
-    if (fixes_of[i] > 0) global_blocks.push_back(calibration[i].data()), global_rsu.push_back(i);
+  collectGlobals();
   const ChainMarginals marginals = result.summary.usable() && (o.covariances || !global_blocks.empty())
                                       ? chainMarginals(problem, state_blocks, global_blocks, std::max(1, o.threads))
                                       : ChainMarginals{};
@@ -475,12 +570,14 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
   std::vector<int> offset_of(impl_->calibrated.size(), -1);
   for (std::size_t g = 0, offset = 0; g < global_rsu.size(); ++g) {
     offset_of[global_rsu[g]] = static_cast<int>(offset);
-    offset += impl_->calibrated[global_rsu[g]].clock ? 4 : 3;  // the held clock is not in the tangent space
+    offset += clock[global_rsu[g]] ? 4 : 3;  // the held clock is not in the tangent space
   }
   for (std::size_t i = 0; i < impl_->calibrated.size(); ++i) {
     RsuCalibration c;
     c.source = impl_->calibrated[i].source;
     c.dx = calibration[i][0], c.dy = calibration[i][1], c.dyaw = calibration[i][2], c.clock_offset = calibration[i][3];
+    c.fixes = fixes_of[i];
+    c.clock_observable = clock[i];
     if (fixes_of[i] == 0) {
       c.note = "no fix of this RSU in the span";
     } else if (marginals.globals) {
@@ -489,8 +586,8 @@ SmootherResult Smoother::solve(Stamp first, Stamp last) const {
       c.sd_dx = std::sqrt(std::max(0.0, C(at, at)));
       c.sd_dy = std::sqrt(std::max(0.0, C(at + 1, at + 1)));
       c.sd_dyaw = std::sqrt(std::max(0.0, C(at + 2, at + 2)));
-      if (impl_->calibrated[i].clock) c.sd_clock_offset = std::sqrt(std::max(0.0, C(at + 3, at + 3)));
-      c.observable = c.sd_dx < 1.0 && c.sd_dy < 1.0 && c.sd_dyaw < 0.1 && (!impl_->calibrated[i].clock || c.sd_clock_offset < 0.1);
+      if (clock[i]) c.sd_clock_offset = std::sqrt(std::max(0.0, C(at + 3, at + 3)));
+      c.observable = c.sd_dx < 1.0 && c.sd_dy < 1.0 && c.sd_dyaw < 0.1 && (!clock[i] || c.sd_clock_offset < 0.1);
       if (!c.observable) c.note = rank_note;
     } else {
       c.note = result.summary.usable() ? rank_note : "the solver failed";

@@ -106,15 +106,23 @@ void addSmoothCommand(CLI::App& app) {
       std::printf("  fixed lag: %d windows of %.1f s every %.2f s; each solved in %.1f ms on average, %.1f ms at most (the latency it adds)\n",
                   r.fixed_lag->windows, r.fixed_lag->window, r.fixed_lag->step, 1e3 * r.fixed_lag->mean_solve_seconds,
                   1e3 * r.fixed_lag->max_solve_seconds);
+    if (!r.summary.noise.empty()) {
+      std::printf("  noise measured on the drive (standard deviation / the messages' own):");
+      for (const auto& n : r.summary.noise) std::printf(" %s %.3g", n.source.c_str(), n.scale);
+      std::printf("\n");
+    }
     for (std::size_t i = 0; i < r.summary.down_weighted.size() && i < 5; ++i) {
       const auto& d = r.summary.down_weighted[i];
       std::printf("    %s stamped %s: %.1f sigma, weight %.3f\n", d.source.c_str(), formatSeconds(d.stamp).c_str(), d.mahalanobis, d.weight);
     }
     for (const auto& [id, c] : r.calibrations) {
-      if (c.observable)
+      if (c.observable && c.clock_observable)
         std::printf("  RSU %s calibration: survey %+.4f m, %+.4f m, %+.3f deg; clock %+.2f ms (sd %.4f m, %.4f m, %.3f deg, %.2f ms)\n",
                     id.c_str(), c.dx, c.dy, c.dyaw * 180.0 / M_PI, c.clock_offset * 1e3, c.sd_dx, c.sd_dy, c.sd_dyaw * 180.0 / M_PI,
                     c.sd_clock_offset * 1e3);
+      else if (c.observable)
+        std::printf("  RSU %s calibration: survey %+.4f m, %+.4f m, %+.3f deg (sd %.4f m, %.4f m, %.3f deg); %s\n", id.c_str(), c.dx, c.dy,
+                    c.dyaw * 180.0 / M_PI, c.sd_dx, c.sd_dy, c.sd_dyaw * 180.0 / M_PI, c.note.c_str());
       else
         std::printf("  RSU %s calibration: not determined (%s)\n", id.c_str(), c.note.c_str());
     }

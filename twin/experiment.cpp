@@ -18,6 +18,7 @@
 #include "coloc/sim/vehicle_motion.hpp"
 #include "coloc/pipeline/config.hpp"
 #include "coloc/replay/log_replay.hpp"
+#include "coloc/replay/log_smoother.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/twin/twin_recording.hpp"
 
@@ -91,29 +92,63 @@ struct Job {
   std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSU, its fixes through the registry's checks
   std::string fix_topic;  ///< the fused RSU topic, empty for NDT only
   std::vector<Eigen::Vector2d> rsu_positions;
+  bool smooth = false;     ///< also smooth the log: `smoothed`
+  bool calibrate = false;  ///< smooth with the RSU's calibration: `calibrated`
+  std::optional<ExperimentRun> smoothed;
+  std::optional<smoother::RsuCalibration> calibration;
+  std::optional<rsu_client::RsuInfo> calibrated;  ///< the registry entry with the calibration found
 };
 
-// Replays one configuration and measures its error along the drive.
+// A run's error along the drive from a replay's ground truth and error samples.
+void fillRun(ExperimentRun& run, const std::vector<io::TrajectoryPoint>& ground_truth, const std::vector<replay::ErrorSample>& errors,
+             const std::vector<Eigen::Vector2d>& rsu_positions) {
+  // Distance along the drive at each ground-truth sample.
+  std::vector<double> along(ground_truth.size(), 0.0);
+  for (std::size_t i = 1; i < ground_truth.size(); ++i)
+    along[i] = along[i - 1] + (ground_truth[i].pose.position.head<2>() - ground_truth[i - 1].pose.position.head<2>()).norm();
+  for (const replay::ErrorSample& e : errors) {
+    const auto it = std::lower_bound(ground_truth.begin(), ground_truth.end(), e.stamp,
+                                     [](const io::TrajectoryPoint& p, Stamp s) { return p.stamp < s; });
+    const std::size_t i = std::min<std::size_t>(it - ground_truth.begin(), along.size() - 1);
+    double to_rsu = 1e300;
+    for (const Eigen::Vector2d& p : rsu_positions) to_rsu = std::min(to_rsu, (e.truth - p).norm());
+    run.along.push_back(along[i]);
+    run.to_rsu.push_back(to_rsu);
+    run.error.push_back(e.error);
+  }
+}
+
+// Replays one configuration (and smooths it, when asked) and measures its error along the drive.
 void runJob(Job& job) {
   replay::ReplayOptions options;
   options.config = job.config;
   options.registry = job.registry;
   options.map = job.map;
-  const replay::ReplayResult r = replay::replayLog(job.log, options);
-  // Distance along the drive at each ground-truth sample.
-  std::vector<double> along(r.ground_truth.size(), 0.0);
-  for (std::size_t i = 1; i < r.ground_truth.size(); ++i)
-    along[i] = along[i - 1] + (r.ground_truth[i].pose.position.head<2>() - r.ground_truth[i - 1].pose.position.head<2>()).norm();
-  for (const replay::ErrorSample& e : r.errors) {
-    const auto it = std::lower_bound(r.ground_truth.begin(), r.ground_truth.end(), e.stamp,
-                                     [](const io::TrajectoryPoint& p, Stamp s) { return p.stamp < s; });
-    const std::size_t i = std::min<std::size_t>(it - r.ground_truth.begin(), along.size() - 1);
-    double to_rsu = 1e300;
-    for (const Eigen::Vector2d& p : job.rsu_positions) to_rsu = std::min(to_rsu, (e.truth - p).norm());
-    job.run.along.push_back(along[i]);
-    job.run.to_rsu.push_back(to_rsu);
-    job.run.error.push_back(e.error);
+  replay::ReplayResult r;
+  if (job.smooth || job.calibrate) {
+    replay::SmoothOptions so;
+    so.replay = options;
+    so.smoother = replay::smootherOptionsFor(job.config.fusion);
+    so.calibrate_rsus = job.calibrate;
+    const replay::SmoothResult s = replay::smoothLog(job.log, so);
+    r = s.filter;
+    if (job.calibrate && job.registry) {
+      for (const auto& [id, c] : s.calibrations) job.calibration = c;
+      const std::vector<rsu_client::RsuInfo> rsus = s.calibratedRegistry().rsus();
+      if (!rsus.empty()) job.calibrated = rsus.front();
+    }
+    if (job.smooth) {
+      ExperimentRun run = job.run;
+      run.variant = kSmootherVariant;
+      run.along.clear(), run.to_rsu.clear(), run.error.clear();
+      fillRun(run, s.filter.ground_truth, s.errors, job.rsu_positions);
+      run.replay_seconds = s.wall_seconds;
+      job.smoothed = std::move(run);
+    }
+  } else {
+    r = replay::replayLog(job.log, options);
   }
+  fillRun(job.run, r.ground_truth, r.errors, job.rsu_positions);
   for (const fusion::SourceReport& s : r.sources)
     if (!job.fix_topic.empty() && s.name == job.fix_topic) {
       job.run.fixes_applied = s.counters.applied;
@@ -191,9 +226,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   struct Drive {
     std::size_t site;
     int trial;
-    std::string variant;  ///< sweep drives
+    std::string variant;  ///< sweep and calibration drives
     double rsu_height = 0.0, speed = 0.0;
   };
+  // The calibration drives: their own seeds, far from the trials'.
+  constexpr int kCalibrationTrial = 500, kNextTrial = 501;
   std::vector<Drive> drives;
   for (std::size_t s = 0; s < config.sites.size(); ++s)
     for (int t = 0; t < config.trials; ++t) drives.push_back({s, t, "", 0.0, 0.0});
@@ -203,6 +240,14 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         for (double h : config.rsu_heights) drives.push_back({s, t, "RSU height", h, 0.0});
         for (double v : config.speeds) drives.push_back({s, t, "speed", 0.0, v});
       }
+  if (config.calibration)
+    for (std::size_t s = 0; s < config.sites.size(); ++s) {
+      drives.push_back({s, kCalibrationTrial, kCalibrationDrive, 0.0, 0.0});
+      drives.push_back({s, kNextTrial, kNextMiscalibrated, 0.0, 0.0});
+      drives.push_back({s, kNextTrial, kNextPerfect, 0.0, 0.0});
+    }
+  // Per site and LiDAR, the registry entry the calibration drive found.
+  std::map<std::pair<std::size_t, std::string>, rsu_client::RsuInfo> calibrated_entries;
 
   std::vector<sim::Scenario> scenarios;
   std::vector<std::string> maps(config.sites.size());
@@ -239,6 +284,16 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       r.variant = buf;
       std::snprintf(buf, sizeof buf, "_speed_%.0f", drive.speed);
       r.name += buf;
+    } else if (!drive.variant.empty()) {  // the calibration drives: every RSU miscalibrated but on the perfect one
+      r.variant = drive.variant;
+      r.name = r.scenario.name + (drive.variant == kCalibrationDrive ? "/calibration_drive"
+                                  : drive.variant == kNextPerfect    ? "/next_drive_perfect_rsu"
+                                                                     : "/next_drive_miscalibrated");
+      if (drive.variant != kNextPerfect)
+        for (sim::ScenarioRsu& rsu : r.scenario.rsus) {
+          rsu.survey_error = Eigen::Vector3d(config.calibration_error[0], config.calibration_error[1], config.calibration_error[2] * M_PI / 180.0);
+          rsu.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
+        }
     }
     const auto t0 = Clock::now();
     r.options.out_dir = results.work_dir + "/" + r.name;
@@ -351,14 +406,50 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
             if (how != main_covariance && how != reference)
               jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(how), varianceFor(how, lidar)));
       }
+    } else if (drive.variant == kCalibrationDrive) {
+      for (const std::string& lidar : config.lidars) {
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
+        jobs.back().calibrate = true;
+      }
+    } else if (drive.variant == kNextMiscalibrated) {
+      for (const std::string& lidar : config.lidars) {
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
+        const auto found = calibrated_entries.find({drive.site, lidar});
+        if (found == calibrated_entries.end()) continue;
+        Job calibrated = makeJob(lidar, 0.0, 0.0, kNextCalibrated, varianceFor(main_covariance, lidar));
+        rsu_client::RsuInfo info = calibrated.registry->rsus().front();
+        info.calibration = found->second.calibration;
+        calibrated.registry = rsu_client::RsuRegistry({info}, rsu_client::CovariancePlacement::kPublished);
+        jobs.push_back(std::move(calibrated));
+      }
     } else {
       if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
       for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
     }
+    // Table I's smoother column: the NDT-only replay and each LiDAR's on the ideal network.
+    if (drive.variant.empty() && config.smoother)
+      for (Job& j : jobs)
+        if (j.run.variant.empty() && j.run.delay == 0.0 && j.run.loss == 0.0) j.smooth = true;
     const auto t1 = Clock::now();
     runJobs(jobs, config.jobs);
     for (Job& j : jobs) {
       results.timing.replay += j.run.replay_seconds;
+      if (j.calibrate) {
+        CalibrationResult c;
+        c.site = scenario.name;
+        c.lidar = j.run.lidar;
+        c.dx = config.calibration_error[0], c.dy = config.calibration_error[1];
+        c.dyaw = config.calibration_error[2] * M_PI / 180.0;
+        c.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
+        if (j.calibration) c.found = *j.calibration;
+        else c.found.note = "no fix of this RSU on the drive";
+        results.calibrations.push_back(c);
+        if (j.calibrated && j.calibrated->calibration) calibrated_entries[{drive.site, j.run.lidar}] = *j.calibrated;
+      }
+      if (j.smoothed) {
+        results.timing.replay += j.smoothed->replay_seconds;
+        results.runs.push_back(std::move(*j.smoothed));
+      }
       results.runs.push_back(std::move(j.run));
     }
     results.timing.replays += jobs.size();

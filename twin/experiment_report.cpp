@@ -99,6 +99,14 @@ void writeFile(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+double errorOutsideCoverage(const ExperimentRun& run, double range) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < run.error.size(); ++i)
+    if (run.to_rsu[i] > range) sum += run.error[i], ++n;
+  return n ? sum / n : 0.0;
+}
+
 ErrorInCoverage errorInCoverage(const ExperimentRun& run, double range, double bin_length) {
   ErrorInCoverage e;
   for (std::size_t i = 0; i < run.error.size(); ++i)
@@ -134,16 +142,16 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   // Table I, with the main covariance and the reference one beside it.
   const std::string reference = std::string("covariance ") + toString(referenceCovariance(c.rsu_covariance));
   std::ostringstream table1, table1_csv;
-  table1 << "| site | roadside LiDAR | coverage | NDT only | NDT + RSU | improvement | NDT + RSU, " << reference
+  table1 << "| site | roadside LiDAR | coverage | NDT only | NDT + RSU | improvement | NDT + RSU, smoother | NDT + RSU, " << reference
          << " | improvement | NDT only (all samples) | NDT + RSU (all samples) | improvement (all samples) |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|\n";
+            "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   table1_csv << "site,lidar,range_m,trials,ndt_paper_m,ndt_paper_sd,fused_paper_m,fused_paper_sd,improvement_paper_pct,improvement_min_pct,"
                 "improvement_max_pct,ndt_mean_m,fused_mean_m,improvement_mean_pct,reference_covariance,fused_reference_paper_m,"
-                "improvement_reference_pct\n";
+                "improvement_reference_pct,smoothed_paper_m,smoothed_mean_m\n";
   for (const SiteInfo& site : results.sites)
     for (const std::string& lidar : c.lidars) {
       const double range = rangeOf(lidar);
-      std::vector<double> ndt_p, fused_p, ndt_m, fused_m, gain, ref_p;
+      std::vector<double> ndt_p, fused_p, ndt_m, fused_m, gain, ref_p, smooth_p, smooth_m;
       for (int t = 0; t < c.trials; ++t) {
         const ExperimentRun* ndt = find(results.runs, site.name, t, "", 0, 0, "");
         const ExperimentRun* fused = find(results.runs, site.name, t, lidar, 0, 0, "");
@@ -153,18 +161,98 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         gain.push_back(improvement(a.paper, b.paper));
         if (const ExperimentRun* ref = find(results.runs, site.name, t, lidar, 0, 0, reference))
           ref_p.push_back(errorInCoverage(*ref, range, bin).paper);
+        if (const ExperimentRun* sm = find(results.runs, site.name, t, lidar, 0, 0, kSmootherVariant)) {
+          const ErrorInCoverage e = errorInCoverage(*sm, range, bin);
+          smooth_p.push_back(e.paper), smooth_m.push_back(e.plain);
+        }
       }
-      const Spread np = spread(ndt_p), fp = spread(fused_p), nm = spread(ndt_m), fm = spread(fused_m), g = spread(gain), rp = spread(ref_p);
+      const Spread np = spread(ndt_p), fp = spread(fused_p), nm = spread(ndt_m), fm = spread(fused_m), g = spread(gain), rp = spread(ref_p),
+                   sp = spread(smooth_p), sm = spread(smooth_m);
       table1 << "| " << site.name << " | " << lidar << " | " << fmt("%.0f m", range) << " | " << cm(np) << " | " << cm(fp) << " | "
              << fmt("%.0f %%", improvement(np.mean, fp.mean)) << (g.n > 1 ? fmt(" (%.0f", g.min) + fmt("-%.0f)", g.max) : "") << " | "
-             << (rp.n ? cm(rp) : "-") << " | " << (rp.n ? fmt("%.0f %%", improvement(np.mean, rp.mean)) : "-") << " | " << cm(nm) << " | "
+             << (sp.n ? cm(sp) : "-") << " | " << (rp.n ? cm(rp) : "-") << " | " << (rp.n ? fmt("%.0f %%", improvement(np.mean, rp.mean)) : "-") << " | " << cm(nm) << " | "
              << cm(fm) << " | " << fmt("%.0f %%", improvement(nm.mean, fm.mean)) << " |\n";
       table1_csv << site.name << "," << lidar << "," << range << "," << np.n << "," << np.mean << "," << np.sd << "," << fp.mean << "," << fp.sd
                  << "," << improvement(np.mean, fp.mean) << "," << g.min << "," << g.max << "," << nm.mean << "," << fm.mean << ","
                  << improvement(nm.mean, fm.mean) << "," << toString(referenceCovariance(c.rsu_covariance)) << "," << rp.mean << ","
-                 << improvement(np.mean, rp.mean) << "\n";
+                 << improvement(np.mean, rp.mean) << "," << (sp.n ? sp.mean : std::nan("")) << "," << (sm.n ? sm.mean : std::nan("")) << "\n";
     }
   writeFile(out_dir + "/table1.csv", table1_csv.str());
+
+  // The smoother against the filter, on the same replays: plain means within and outside coverage.
+  std::ostringstream smoother_md;
+  {
+    std::ostringstream csv;
+    csv << "site,lidar,range_m,trials,ndt_filter_in_m,ndt_smoother_in_m,fused_filter_in_m,fused_smoother_in_m,ratio_in,fused_filter_out_m,"
+           "fused_smoother_out_m,ratio_out\n";
+    smoother_md << "| site | roadside LiDAR | NDT only: filter | NDT only: smoother | NDT + RSU: filter | NDT + RSU: smoother | smoother / filter "
+                   "in coverage | NDT + RSU outside coverage: filter | smoother | smoother / filter outside |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const SiteInfo& site : results.sites)
+      for (const std::string& lidar : c.lidars) {
+        const double range = rangeOf(lidar);
+        std::vector<double> nf, ns, ff, fs, ffo, fso;
+        for (int t = 0; t < c.trials; ++t) {
+          const ExperimentRun* ndt = find(results.runs, site.name, t, "", 0, 0, "");
+          const ExperimentRun* ndt_s = find(results.runs, site.name, t, "", 0, 0, kSmootherVariant);
+          const ExperimentRun* fused = find(results.runs, site.name, t, lidar, 0, 0, "");
+          const ExperimentRun* fused_s = find(results.runs, site.name, t, lidar, 0, 0, kSmootherVariant);
+          if (!ndt || !ndt_s || !fused || !fused_s) continue;
+          nf.push_back(errorInCoverage(*ndt, range, bin).plain);
+          ns.push_back(errorInCoverage(*ndt_s, range, bin).plain);
+          ff.push_back(errorInCoverage(*fused, range, bin).plain);
+          fs.push_back(errorInCoverage(*fused_s, range, bin).plain);
+          ffo.push_back(errorOutsideCoverage(*fused, range));
+          fso.push_back(errorOutsideCoverage(*fused_s, range));
+        }
+        if (nf.empty()) continue;
+        const Spread a = spread(nf), b = spread(ns), f1 = spread(ff), f2 = spread(fs), o1 = spread(ffo), o2 = spread(fso);
+        smoother_md << "| " << site.name << " | " << lidar << " | " << cm(a) << " | " << cm(b) << " | " << cm(f1) << " | " << cm(f2) << " | "
+                    << fmt("%.2fx", f2.mean / f1.mean) << " | " << cm(o1) << " | " << cm(o2) << " | " << fmt("%.2fx", o2.mean / o1.mean) << " |\n";
+        csv << site.name << "," << lidar << "," << range << "," << a.n << "," << a.mean << "," << b.mean << "," << f1.mean << "," << f2.mean << ","
+            << f2.mean / f1.mean << "," << o1.mean << "," << o2.mean << "," << o2.mean / o1.mean << "\n";
+      }
+    if (!smoother_md.str().empty()) writeFile(out_dir + "/smoother.csv", csv.str());
+  }
+
+  // The calibration table: what one drive found, and what it is worth on the next one.
+  std::ostringstream calibration_md;
+  if (!results.calibrations.empty()) {
+    std::ostringstream csv;
+    csv << "site,lidar,injected_dx_m,injected_dy_m,injected_dyaw_deg,injected_clock_ms,dx_m,dy_m,dyaw_deg,clock_ms,sd_dx_m,sd_dy_m,sd_dyaw_deg,"
+           "sd_clock_ms,observable,clock_observable,next_as_surveyed_m,next_calibrated_m,next_perfect_m\n";
+    calibration_md << "| site | roadside LiDAR | injected (dx, dy, dyaw, clock) | found (± sd) | next drive, registry as surveyed | "
+                      "calibrated | perfect RSU | calibrated / perfect |\n|---|---|---|---|---|---|---|---|\n";
+    const double deg = 180.0 / M_PI;
+    for (const CalibrationResult& cr : results.calibrations) {
+      const double range = rangeOf(cr.lidar);
+      auto next = [&](const char* variant) {
+        const ExperimentRun* r = nullptr;
+        for (const ExperimentRun& run : results.runs)
+          if (run.site == cr.site && run.lidar == cr.lidar && run.variant == variant) r = &run;
+        return r ? errorInCoverage(*r, range, bin).plain : std::nan("");
+      };
+      const double as_surveyed = next(kNextMiscalibrated), calibrated = next(kNextCalibrated), perfect = next(kNextPerfect);
+      const smoother::RsuCalibration& f = cr.found;
+      char injected[128], found[192];
+      std::snprintf(injected, sizeof injected, "%.3f m, %.3f m, %.2f deg, %.1f ms", cr.dx, cr.dy, cr.dyaw * deg, cr.clock_offset * 1e3);
+      if (f.observable && f.clock_observable)
+        std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %.1f ± %.1f ms", f.dx, f.sd_dx, f.dy, f.sd_dy, f.dyaw * deg,
+                      f.sd_dyaw * deg, f.clock_offset * 1e3, f.sd_clock_offset * 1e3);
+      else if (f.observable)
+        std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, clock not separable (one speed): held at 0", f.dx, f.sd_dx,
+                      f.dy, f.sd_dy, f.dyaw * deg, f.sd_dyaw * deg);
+      else
+        std::snprintf(found, sizeof found, "not determined (%s)", f.note.c_str());
+      calibration_md << "| " << cr.site << " | " << cr.lidar << " | " << injected << " | " << found << " | " << fmt("%.2f cm", 100 * as_surveyed)
+                     << " | " << (std::isnan(calibrated) ? std::string("-") : fmt("%.2f cm", 100 * calibrated)) << " | "
+                     << fmt("%.2f cm", 100 * perfect) << " | " << (std::isnan(calibrated) ? std::string("-") : fmt("%.2fx", calibrated / perfect))
+                     << " |\n";
+      csv << cr.site << "," << cr.lidar << "," << cr.dx << "," << cr.dy << "," << cr.dyaw * deg << "," << cr.clock_offset * 1e3 << "," << f.dx << ","
+          << f.dy << "," << f.dyaw * deg << "," << f.clock_offset * 1e3 << "," << f.sd_dx << "," << f.sd_dy << "," << f.sd_dyaw * deg << ","
+          << f.sd_clock_offset * 1e3 << "," << (f.observable ? 1 : 0) << "," << (f.clock_observable ? 1 : 0) << "," << as_surveyed << "," << calibrated << "," << perfect << "\n";
+    }
+    writeFile(out_dir + "/calibration.csv", csv.str());
+  }
 
   // Tables II and III: the network grid, per LiDAR, over sites and trials.
   std::ostringstream network_md, network_csv;
@@ -287,7 +375,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     sweeps_md << "| variant | roadside LiDAR | NDT only | NDT + RSU | improvement | NDT + RSU (all samples) |\n|---|---|---|---|---|---|\n";
     std::vector<std::string> variants = {""};
     for (const ExperimentRun& r : results.runs)
-      if (!r.variant.empty() && std::find(variants.begin(), variants.end(), r.variant) == variants.end()) variants.push_back(r.variant);
+      if (!r.variant.empty() && r.variant != kSmootherVariant && std::find(variants.begin(), variants.end(), r.variant) == variants.end())
+        variants.push_back(r.variant);
     for (const std::string& variant : variants)
       for (const std::string& lidar : c.lidars) {
         const double range = rangeOf(lidar);
@@ -331,6 +420,15 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         "variance of the fixes' error on the site's first drive, a calibration pass).\n\n"
      << "## Table I: error within coverage\n\n"
      << table1.str() << "\n";
+  if (!smoother_md.str().empty())
+    md << "## The smoother against the filter\n\nThe same replays smoothed by the Ceres smoother (`coloc smooth`: every measurement for "
+          "every pose, each source's noise measured on the drive); plain means of all samples, within and outside the LiDAR's coverage.\n\n"
+       << smoother_md.str() << "\n";
+  if (!calibration_md.str().empty())
+    md << "## RSU self-calibration\n\nEvery RSU of the site miscalibrated (its surveyed pose and clock); one drive past it calibrates it "
+          "(`coloc smooth --calibrate-rsus`, anchored by NDT), and the filter replays a second drive with the registry as surveyed, with the "
+          "calibration found, and past a perfect RSU (same drive). Errors: plain mean within coverage.\n\n"
+       << calibration_md.str() << "\n";
   if (c.network)
     md << "## Tables II and III: network delay and packet loss\n\nMean over both sites and the first " << std::min(c.trials, c.network_trials)
        << " trial(s) of each; every cell replays the same drives.\n" << network_md.str() << "\n![network](network.svg)\n\n";
@@ -354,7 +452,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
      << "(" << c.jobs << " side by side).\n\n"
      << "## Files\n\n"
-     << "- `table1.csv`, `network.csv`, `sweeps.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
+     << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
      << "- `error_along_road.csv`: minimum error per bin along the road, per site, trial and configuration (figures 4 and 5)\n"
      << "- `recordings/SITE/trial_N/`: each drive as a rosbag2 log with its map and fuse configuration (`coloc fuse` replays it), the "
         "RSU fixes and, for trial 0, what each perception step buys (`rsu_perception.svg`)\n";

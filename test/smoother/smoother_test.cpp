@@ -133,16 +133,16 @@ namespace {
 // 100 ms. The RSU at (40, -8) has its survey off by (0.15 m, -0.05 m, 0.5 deg) and its clock 20 ms ahead.
 struct BendDrive {
   static constexpr double kV0 = 4.0, kA = 0.7;
-  static Vector6d at(double t) { return (Vector6d() << kV0 * t + 0.5 * kA * t * t, 0.0, 0.0, 0.0, kV0 + kA * t, 0.0).finished(); }
+  static Vector6d at(double t, double a = kA) { return (Vector6d() << kV0 * t + 0.5 * a * t * t, 0.0, 0.0, 0.0, kV0 + a * t, 0.0).finished(); }
 };
 
-Smoother bendDrive(bool anchored, const Eigen::Vector3d& survey_error, double clock_offset) {
+Smoother bendDrive(bool anchored, const Eigen::Vector3d& survey_error, double clock_offset, double acceleration = BendDrive::kA) {
   Smoother s;
   const Eigen::Vector2d rsu_true(40.0, -8.0);
   const Eigen::Vector2d rsu_surveyed = rsu_true + survey_error.head<2>();
   for (int k = 0; k <= 600; ++k) {
     const double t = k * 0.02;
-    const Vector6d x = BendDrive::at(t);
+    const Vector6d x = BendDrive::at(t, acceleration);
     TwistMeasurement tw;
     tw.stamp = at(t);
     tw.linear = {x[4], 0.0, 0.0};
@@ -184,6 +184,23 @@ TEST(RsuCalibration, RecoversASurveyAndClockErrorFromOneDriveAnchoredByNdt) {
   EXPECT_NEAR(c.clock_offset, 0.020, 0.002);
   EXPECT_GT(c.sd_dx, 0.0);
   EXPECT_LT(c.sd_dx, 0.01);
+}
+
+TEST(RsuCalibration, AtOneSpeedTheClockIsHeldAndTheSurveyAbsorbsItsAlongRoadShift) {
+  // At 4 m/s throughout, a clock 20 ms ahead stamps every fix 20 ms late, where the vehicle is 8 cm
+  // farther on: the fixes lag 8 cm, as a survey offset of -8 cm would make them. The clock is reported
+  // as not separable, and the survey offset found is 0.15 - 0.08 m.
+  const Eigen::Vector3d error(0.15, -0.05, 0.5 * M_PI / 180.0);
+  const SmootherResult r = bendDrive(true, error, 0.020, 0.0).solve(at(0.0), at(12.0));
+  ASSERT_TRUE(r.summary.usable()) << r.summary.report;
+  ASSERT_EQ(r.calibrations.size(), 1u);
+  const RsuCalibration& c = r.calibrations[0];
+  EXPECT_TRUE(c.observable) << c.note;
+  EXPECT_FALSE(c.clock_observable);
+  EXPECT_EQ(c.clock_offset, 0.0);
+  EXPECT_NEAR(c.dx, 0.15 - BendDrive::kV0 * 0.020, 0.01);
+  EXPECT_NEAR(c.dy, -0.05, 0.01);
+  EXPECT_NEAR(c.dyaw * 180.0 / M_PI, 0.5, 0.05);
 }
 
 TEST(RsuCalibration, WithoutAnAnchoringSourceItIsReportedUnobservableNotInvented) {

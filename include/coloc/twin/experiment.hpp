@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/smoother/smoother.hpp"
 #include "coloc/twin/experiment_config.hpp"
 
 namespace coloc::twin {
@@ -30,6 +31,19 @@ struct ExperimentRun {
   std::string label() const;  ///< "NDT only", "NDT + VLP-16", "NDT + VLP-16, 30 ms, 20 % loss"
 };
 
+/// One RSU's calibration on a site: what was injected and what one drive past it found. The next
+/// drive's replays (variants kNextMiscalibrated, kNextCalibrated, kNextPerfect) show what it is worth.
+struct CalibrationResult {
+  std::string site, lidar;
+  double dx = 0.0, dy = 0.0, dyaw = 0.0, clock_offset = 0.0;  ///< injected: m, m, rad, s
+  smoother::RsuCalibration found;
+};
+inline constexpr const char* kSmootherVariant = "smoother";
+inline constexpr const char* kCalibrationDrive = "calibration drive";
+inline constexpr const char* kNextMiscalibrated = "next drive, registry as surveyed";
+inline constexpr const char* kNextCalibrated = "next drive, calibrated registry";
+inline constexpr const char* kNextPerfect = "next drive, perfect RSU";
+
 struct ExperimentTiming {
   double total = 0.0, survey = 0.0, simulation = 0.0, replay = 0.0;  ///< s; replay summed over the jobs
   double ray_casting = 0.0, perception = 0.0;                         ///< s, within simulation
@@ -50,6 +64,7 @@ struct ExperimentResults {
   ExperimentTiming timing;
   /// "SITE LIDAR" -> the fixes' variance estimated on the site's first drive, m^2 (when used).
   std::map<std::string, double> estimated_variance;
+  std::vector<CalibrationResult> calibrations;
   std::string work_dir;  ///< the recordings
 };
 

@@ -45,6 +45,15 @@ struct ExperimentConfig {
   /// Sweep values besides the paper's (RSU 2 m high, 10 m/s), whose runs are the main experiment's.
   std::vector<double> rsu_heights = {3.0, 4.5};  ///< m
   std::vector<double> speeds = {5.0, 15.0};      ///< m/s
+  /// Smooth the main replays (NDT only, and NDT + each LiDAR on the ideal network) with the Ceres
+  /// smoother too: Table I's smoother column.
+  bool smoother = true;
+  /// The calibration table: per site, every RSU miscalibrated by `calibration_error` and
+  /// `calibration_clock_offset_ms`; one drive calibrates it (coloc smooth --calibrate-rsus), and the
+  /// filter on a second drive runs with the miscalibrated registry, the calibrated one, and a perfect RSU.
+  bool calibration = true;
+  std::vector<double> calibration_error = {0.15, 0.0, 0.5};  ///< [dx m, dy m, dyaw deg], surveyed minus true
+  double calibration_clock_offset_ms = 20.0;                 ///< the RSU's clock minus the vehicle's
 };
 
 /// The quick mode: one trial of everything, for a first look in a minute or two.

@@ -18,6 +18,9 @@ struct ErrorInCoverage {
 /// The error of `run` where the vehicle is within `range` of the RSU. No samples: zeros.
 ErrorInCoverage errorInCoverage(const ExperimentRun& run, double range, double bin_length);
 
+/// The plain mean error of `run` where the vehicle is farther than `range` from every RSU (0: no samples).
+double errorOutsideCoverage(const ExperimentRun& run, double range);
+
 /// Writes tables, figures, CSVs and README.md into out_dir; returns Table I as Markdown.
 std::string writeExperimentReport(const ExperimentResults& results, const std::string& out_dir, const std::string& command_line);
 
