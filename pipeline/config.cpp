@@ -261,6 +261,36 @@ const std::vector<Key>& keys() {
        [](const R& r, const N& n, const S& k, C& c) {
          c.replay.ground_truth_max_gap = r.inRange(n, k, 0.0, 10.0);
          if (c.replay.ground_truth_max_gap == 0.0) r.fail(n, k, "must be > 0"); }},
+      // ---- smoother
+      {"smoother", "estimate_noise", "", "measure each source's noise on the drive instead of taking the messages' covariances as given",
+       [](const C& c) { return S(c.smoother.estimate_noise ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.estimate_noise = r.flag(n, k); }},
+      {"smoother", "calibrate_odometry", "", "estimate each odometry's speed scale and yaw-rate bias with the trajectory",
+       [](const C& c) { return S(c.smoother.calibrate_odometry ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.calibrate_odometry = r.flag(n, k); }},
+      {"smoother", "odometry_scale_sd", "", "prior standard deviation of the odometry's speed scale around 1",
+       [](const C& c) { return show(c.smoother.odometry_scale_sd); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.odometry_scale_sd = r.inRange(n, k, 1e-6, 1.0); }},
+      {"smoother", "odometry_yaw_rate_bias_sd", "rad/s", "prior standard deviation of the odometry's yaw-rate bias around 0",
+       [](const C& c) { return show(c.smoother.odometry_yaw_rate_bias_sd); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.odometry_yaw_rate_bias_sd = r.inRange(n, k, 1e-9, 1.0); }},
+      {"smoother", "pose_bias", "", "model a slowly varying bias of map-matching poses (NDT): when_calibrating (RSUs), always or never",
+       [](const C& c) {
+         using P = SmootherSection::PoseBias;
+         return S(c.smoother.pose_bias == P::kAlways ? "always" : c.smoother.pose_bias == P::kNever ? "never" : "when_calibrating"); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         using P = SmootherSection::PoseBias;
+         const S v = r.choice(n, k, {"when_calibrating", "always", "never"});
+         c.smoother.pose_bias = v == "always" ? P::kAlways : v == "never" ? P::kNever : P::kWhenCalibrating; }},
+      {"smoother", "pose_bias_time", "s", "correlation time of that bias",
+       [](const C& c) { return show(c.smoother.pose_bias_time); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.pose_bias_time = r.inRange(n, k, 0.05, 1e4); }},
+      {"smoother", "proc_stddev_position_c", "m/s", "random walk of the position, which the filter's model moves without noise",
+       [](const C& c) { return show(c.smoother.proc_stddev_position_c); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.proc_stddev_position_c = r.inRange(n, k, 1e-9, 10.0); }},
+      {"smoother", "proc_stddev_yaw_bias_c", "rad/s", "random walk of the yaw bias, likewise",
+       [](const C& c) { return show(c.smoother.proc_stddev_yaw_bias_c); },
+       [](const R& r, const N& n, const S& k, C& c) { c.smoother.proc_stddev_yaw_bias_c = r.inRange(n, k, 1e-12, 1.0); }},
       // ---- live
       {"live", "scan_topic", "", "PointCloud2 scans for NDT", [](const C& c) { return quoted(c.live.scan_topic); },
        [](const R& r, const N& n, const S& k, C& c) { c.live.scan_topic = r.text(n, k); }},
@@ -288,7 +318,7 @@ const std::vector<Key>& keys() {
   return table;
 }
 
-const char* kSections[] = {"ndt", "rsu", "pipeline", "messages", "replay", "live"};
+const char* kSections[] = {"ndt", "rsu", "pipeline", "messages", "replay", "smoother", "live"};
 
 const char* sectionComment(const std::string& section) {
   if (section == "ndt") return "# Scan matching of PointCloud2 scans against the map given with --map.";
@@ -296,6 +326,7 @@ const char* sectionComment(const std::string& section) {
   if (section == "pipeline") return "# The vehicle pipeline.";
   if (section == "messages") return "# How messages become measurements.";
   if (section == "replay") return "# Offline replay of recorded logs (coloc fuse).";
+  if (section == "smoother") return "# The Ceres smoother of recorded logs (coloc smooth); rate, process noise and gate follow the fusion section.";
   return "# The live localizer's topics (coloc localize): ROS 2 names, DDS adds \"rt\".";
 }
 

@@ -154,7 +154,7 @@ struct Pipeline::Impl {
   PipelineReport report;
   std::function<void(const fusion::Estimate&)> on_estimate;
   std::function<void(const std::string&, const PoseMeasurement&)> on_pose_input;
-  std::function<void(const std::string&, const TwistMeasurement&)> on_twist_input;
+  std::function<void(const std::string&, const TwistMeasurement&, const TwistMeasurement&)> on_twist_input;
   std::function<void(const std::string&)> on_rejection;
 
   mutable std::mutex estimate_mutex;
@@ -274,7 +274,7 @@ struct Pipeline::Impl {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
       }
-      if (on_twist_input) on_twist_input(source_names[twist->source], t);
+      if (on_twist_input) on_twist_input(source_names[twist->source], t, twist->twist);
       localizer.feedTwist(twist->source, t);
     } else if (auto* pose = std::get_if<PoseInput>(&input)) {
       feedPose(pose->source, pose->pose);
@@ -359,7 +359,7 @@ void Pipeline::onPoseInput(std::function<void(const std::string&, const PoseMeas
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_pose_input = std::move(callback);
 }
-void Pipeline::onTwistInput(std::function<void(const std::string&, const TwistMeasurement&)> callback) {
+void Pipeline::onTwistInput(std::function<void(const std::string&, const TwistMeasurement&, const TwistMeasurement&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_twist_input = std::move(callback);
 }

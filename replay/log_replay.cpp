@@ -184,7 +184,11 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
     result.pose_input_sources.push_back(source);
     if (keep) result.filter_poses.emplace_back(source, p);
   });
-  if (keep) pipe.onTwistInput([&](const std::string& source, const TwistMeasurement& t) { result.filter_twists.emplace_back(source, t); });
+  if (keep)
+    pipe.onTwistInput([&](const std::string& source, const TwistMeasurement& handed, const TwistMeasurement& received) {
+      result.filter_twists.emplace_back(source, handed);
+      result.received_twists.emplace_back(source, received);
+    });
   pipe.onRejection([&](const std::string& line) {
     if (result.rejections.size() < 20) result.rejections.push_back(line);
   });

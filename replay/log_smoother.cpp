@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "coloc/core/error.hpp"
@@ -11,7 +12,9 @@
 
 namespace coloc::replay {
 
-smoother::SmootherOptions smootherOptionsFor(const fusion::EkfConfig& filter) {
+smoother::SmootherOptions smootherOptionsFor(const pipeline::Config& config, bool calibrating_rsus) {
+  const fusion::EkfConfig& filter = config.fusion;
+  const pipeline::SmootherSection& c = config.smoother;
   smoother::SmootherOptions o;
   o.rate = filter.predict_frequency;
   o.proc_stddev_yaw_c = filter.proc_stddev_yaw_c;
@@ -20,6 +23,15 @@ smoother::SmootherOptions smootherOptionsFor(const fusion::EkfConfig& filter) {
   o.initial_yaw_bias_variance = filter.initial_yaw_bias_variance;
   o.robust = filter.pose_gate_alpha > 0.0;
   if (o.robust) o.gate_alpha = filter.pose_gate_alpha;
+  o.estimate_noise = c.estimate_noise;
+  o.calibrate_odometry = c.calibrate_odometry;
+  o.odometry_scale_sd = c.odometry_scale_sd;
+  o.odometry_yaw_rate_bias_sd = c.odometry_yaw_rate_bias_sd;
+  using PoseBias = pipeline::SmootherSection::PoseBias;
+  o.pose_bias = c.pose_bias == PoseBias::kAlways || (c.pose_bias == PoseBias::kWhenCalibrating && calibrating_rsus);
+  o.pose_bias_time = c.pose_bias_time;
+  o.proc_stddev_position_c = c.proc_stddev_position_c;
+  o.proc_stddev_yaw_bias_c = c.proc_stddev_yaw_bias_c;
   return o;
 }
 
@@ -51,9 +63,11 @@ void smoothFixedLag(const SmoothOptions& options, SmoothResult& result) {
   const Duration window = fromSeconds(options.window), step = fromSeconds(std::max(options.window_step, 1e-3));
   smoother::SmootherOptions o = options.smoother;
   o.covariances = false;  // a vehicle running behind the filter wants the states, now
-  // A window of a second or two is too short to measure the sources' noise in; it takes the
-  // covariances as given, as the filter does.
+  // A window of a second or two is too short to measure the sources' noise in, or their biases and
+  // the odometry's calibration: it takes the inputs as the filter does.
   o.estimate_noise = false;
+  o.calibrate_odometry = false;  // the filter's twists, scaled as it scaled them
+  o.pose_bias = false;
   const Stamp first = f.fused_states.front().first, last = f.fused_states.back().first;
   std::size_t start_index = 0;
   for (Stamp end = first + window; end <= last; end += step) {
@@ -110,10 +124,20 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   if (options.replay.config.pipeline.initial_pose && !f.fused_state_covariances.empty())
     s.addPrior(f.fused_states.front().first, f.fused_states.front().second, f.fused_state_covariances.front());
   for (const auto& [source, pose] : f.filter_poses) s.addPose(source, pose);
-  for (const auto& [source, twist] : f.filter_twists) s.addTwist(source, twist);
+  // With the odometry's calibration estimated, the twists as the log has them: the filter's were
+  // scaled by what NDT had taught so far, a scale that changes along the drive.
+  for (const auto& [source, twist] : options.smoother.calibrate_odometry ? f.received_twists : f.filter_twists) s.addTwist(source, twist);
   std::optional<rsu_client::RsuRegistry> registry = options.replay.registry;
   if (!registry && !options.replay.config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(options.replay.config.rsu.registry);
   if (registry) result.registry = *registry;
+  // Every pose source but the RSUs' fixes is map matching of some kind, whose error is a slow bias.
+  std::set<std::string> fix_sources;
+  if (registry)
+    for (const rsu_client::RsuInfo& rsu : registry->rsus()) fix_sources.insert(rsu_client::fixTopic(rsu.id));
+  for (const auto& [topic, input] : options.replay.config.inputs)
+    if (input.role == pipeline::InputRole::kRsuFix) fix_sources.insert(topic);
+  for (const auto& [source, pose] : f.filter_poses)
+    if (!fix_sources.count(source)) s.setPoseBias(source);
   if (options.calibrate_rsus) {
     if (!registry) throw Error("smooth: --calibrate-rsus needs an RSU registry (rsu.registry or --rsu-registry)");
     for (const rsu_client::RsuInfo& rsu : registry->rsus()) s.calibrateRsu(rsu_client::fixTopic(rsu.id), rsu.position);
@@ -121,6 +145,7 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   const smoother::SmootherResult r = s.solve(f.fused_states.front().first, f.fused_states.back().first);
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.summary = r.summary;
+  result.odometry = r.odometry;
   if (registry)
     for (std::size_t i = 0; i < r.calibrations.size() && i < registry->rsus().size(); ++i) result.calibrations[registry->rsus()[i].id] = r.calibrations[i];
   result.states = r.states;
@@ -158,6 +183,12 @@ std::string SmoothResult::summaryJson(const std::string& log) const {
   j["filter_position_error"] = errorJson(filter_errors_matched, "error.csv");
   if (fixed_lag)
     j["fixed_lag"] = {{"window_s", fixed_lag->window}, {"step_s", fixed_lag->step}, {"windows", fixed_lag->windows}};
+  if (!odometry.empty()) {
+    auto& odo = j["odometry_calibration"] = nlohmann::ordered_json::object();
+    for (const smoother::OdometryCalibration& o : odometry)
+      odo[o.source] = {{"speed_scale", o.speed_scale}, {"sd_speed_scale", o.sd_speed_scale}, {"yaw_rate_bias_rad_s", o.yaw_rate_bias},
+                       {"sd_yaw_rate_bias_rad_s", o.sd_yaw_rate_bias}};
+  }
   if (!summary.noise.empty()) {
     auto& noise = j["noise_scale"] = nlohmann::ordered_json::object();  // measured sd / the covariances' sd
     for (const smoother::NoiseScale& n : summary.noise) noise[n.source] = n.scale;

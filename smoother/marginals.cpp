@@ -7,9 +7,10 @@
 
 namespace coloc::smoother {
 
-using Block = Eigen::Matrix<double, 6, 6>;
+using Block = Eigen::MatrixXd;
 
-ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads) {
+ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads,
+                              int size) {
   ChainMarginals out;
   const std::size_t n = states.size();
   if (n == 0) return out;
@@ -22,11 +23,11 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
   eo.num_threads = threads;
   ceres::CRSMatrix J;
   if (!problem.Evaluate(eo, nullptr, nullptr, nullptr, &J)) return out;
-  const int state_columns = static_cast<int>(6 * n);
+  const int state_columns = static_cast<int>(size * n);
   const int m = J.num_cols - state_columns;  // the globals' tangent dimensions together
 
   // H = J^T J as D (diagonal blocks), E (the block right of each diagonal one), B (states x globals), C.
-  std::vector<Block> D(n, Block::Zero()), E(n, Block::Zero());
+  std::vector<Block> D(n, Block::Zero(size, size)), E(n, Block::Zero(size, size));
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(state_columns, m), C = Eigen::MatrixXd::Zero(m, m);
   for (int r = 0; r < J.num_rows; ++r) {
     const int begin = J.rows[r], end = J.rows[r + 1];
@@ -38,9 +39,9 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
         const int cb = J.cols[b];
         const double v = va * J.values[b];
         if (ca < state_columns && cb < state_columns) {
-          const int ka = ca / 6, kb = cb / 6;
-          if (ka == kb) D[ka](ca % 6, cb % 6) += v;
-          else if (kb == ka + 1) E[ka](ca % 6, cb % 6) += v;
+          const int ka = ca / size, kb = cb / size;
+          if (ka == kb) D[ka](ca % size, cb % size) += v;
+          else if (kb == ka + 1) E[ka](ca % size, cb % size) += v;
           else if (ka != kb + 1) return out;  // not a chain
         } else if (ca < state_columns) {
           B(ca, cb - state_columns) += v;
@@ -58,7 +59,7 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
     Block s = D[k];
     if (k > 0) {
       s -= E[k - 1].transpose() * S[k - 1].solve(E[k - 1]);
-      if (m > 0) Y.middleRows<6>(6 * k) -= E[k - 1].transpose() * S[k - 1].solve(Y.middleRows<6>(6 * (k - 1)));
+      if (m > 0) Y.middleRows(size * k, size) -= E[k - 1].transpose() * S[k - 1].solve(Y.middleRows(size * (k - 1), size));
     }
     S[k].compute(s);
     if (S[k].info() != Eigen::Success) return out;
@@ -67,13 +68,13 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
   // G_k = S_k^-1 E_k).
   Eigen::MatrixXd X(state_columns, m);
   out.states.resize(n);
-  const Block I = Block::Identity();
+  const Block I = Block::Identity(size, size);
   out.states[n - 1] = S[n - 1].solve(I);
-  if (m > 0) X.middleRows<6>(6 * (n - 1)) = S[n - 1].solve(Y.middleRows<6>(6 * (n - 1)));
+  if (m > 0) X.middleRows(size * (n - 1), size) = S[n - 1].solve(Y.middleRows(size * (n - 1), size));
   for (std::size_t k = n - 1; k-- > 0;) {
     const Block G = S[k].solve(E[k]);
     out.states[k] = S[k].solve(I) + G * out.states[k + 1] * G.transpose();
-    if (m > 0) X.middleRows<6>(6 * k) = S[k].solve(Y.middleRows<6>(6 * k)) - G * X.middleRows<6>(6 * (k + 1));
+    if (m > 0) X.middleRows(size * k, size) = S[k].solve(Y.middleRows(size * k, size)) - G * X.middleRows(size * (k + 1), size);
   }
 
   // The globals: their covariance is the inverse of their Schur complement C - B^T A^-1 B, and each
@@ -89,7 +90,7 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
     }
     const Eigen::MatrixXd inverse = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
     for (std::size_t k = 0; k < n; ++k) {
-      const auto Xk = X.middleRows<6>(6 * k);
+      const auto Xk = X.middleRows(size * k, size);
       out.states[k] += Xk * inverse * Xk.transpose();
     }
     out.globals = inverse;

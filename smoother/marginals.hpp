@@ -17,7 +17,7 @@ class Problem;
 namespace coloc::smoother {
 
 struct ChainMarginals {
-  std::vector<Eigen::Matrix<double, 6, 6>> states;  ///< one per state block, in order
+  std::vector<Eigen::MatrixXd> states;  ///< one per state block, in order
   /// The global blocks' joint covariance, in their tangent spaces, in order; empty without them.
   /// Unset when the problem does not determine them (its Schur complement is singular): the states'
   /// covariances are then unset too, as they are not determined either.
@@ -25,9 +25,10 @@ struct ChainMarginals {
   bool ok = false;  ///< false: not a chain, or not determined; `states` is then empty
 };
 
-/// `states` are the 6-parameter blocks in chain order; `globals` any number of other blocks (each in
+/// `states` are the `size`-parameter blocks in chain order; `globals` any number of other blocks (each in
 /// the problem with at least one residual). The robust losses are applied to the Jacobian, as
 /// ceres::Covariance does.
-ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads);
+ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads,
+                              int size);
 
 }  // namespace coloc::smoother

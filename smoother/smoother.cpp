@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "coloc/core/chi_square.hpp"
 #include "coloc/core/error.hpp"
@@ -15,6 +16,10 @@
 namespace coloc::smoother {
 
 namespace {
+
+// The state blocks: the filter's six (x, y, yaw, yaw bias, vx, wz), then the slowly varying error
+// (bx, by) that map-matching pose sources share (SmootherOptions::pose_bias).
+constexpr int kState = 8;
 
 // The filter's motion model, written once for doubles and Ceres' Jets: constant speed and yaw rate,
 // moving along yaw + yaw bias.
@@ -75,6 +80,7 @@ struct MotionResidual {
 // A measurement of some of (x, y, yaw) at `dt` after the state it hangs on.
 struct PoseResidual {
   double dt;
+  bool biased;  ///< the source measures the position plus the shared pose bias
   int m;
   int component[3];  ///< state index of each measured component: 0 x, 1 y, 2 yaw
   double value[3];
@@ -86,6 +92,7 @@ struct PoseResidual {
     T e[3];
     for (int j = 0; j < m; ++j) {
       e[j] = p[component[j]] - value[j];
+      if (biased && component[j] < 2) e[j] += s[6 + component[j]];
       if (component[j] == 2) e[j] = wrapped(e[j]);
     }
     for (int i = 0; i < m; ++i) {
@@ -115,6 +122,37 @@ struct TwistResidual {
   }
 };
 
+// A twist through its source's calibration o = (speed scale, yaw-rate bias): the odometry reads
+// scale * vx and wz + bias.
+struct CalibratedTwistResidual {
+  TwistResidual twist;
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* o, T* r) const {
+    T e[2];
+    for (int j = 0; j < twist.m; ++j) {
+      const int c = twist.component[j];
+      const T state = (1.0 - twist.w) * a[c] + twist.w * b[c];
+      e[j] = (c == 4 ? o[0] * state : state + o[1]) - twist.value[j];
+    }
+    for (int i = 0; i < twist.m; ++i) {
+      r[i] = T(0.0);
+      for (int j = 0; j <= i; ++j) r[i] += twist.whitening(i, j) * e[j];
+    }
+    return true;
+  }
+};
+
+// What an odometry's calibration is before the drive says otherwise: scale 1, no bias.
+struct OdometryPrior {
+  double inverse_sd_scale, inverse_sd_bias;
+  template <typename T>
+  bool operator()(const T* o, T* r) const {
+    r[0] = (o[0] - 1.0) * inverse_sd_scale;
+    r[1] = o[1] * inverse_sd_bias;
+    return true;
+  }
+};
+
 // A roadside fix corrected by its RSU's calibration c = (dx, dy, dyaw, clock offset): the RSU computed
 // it through its surveyed pose, so the vehicle was at ps - d + R(-dyaw) (z - ps), at the fix's stamp
 // minus the clock offset.
@@ -135,6 +173,28 @@ struct CalibratedFixResidual {
     const T e0 = p[0] - x, e1 = p[1] - y;
     r[0] = whitening(0, 0) * e0;
     r[1] = whitening(1, 0) * e0 + whitening(1, 1) * e1;
+    return true;
+  }
+};
+
+// The pose bias as a first-order Gauss-Markov process: b' = phi b, with the noise that keeps its
+// standard deviation steady.
+struct BiasProcess {
+  double phi, inverse_sigma;
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    r[0] = (b[6] - phi * a[6]) * inverse_sigma;
+    r[1] = (b[7] - phi * a[7]) * inverse_sigma;
+    return true;
+  }
+};
+
+struct BiasPrior {
+  double inverse_sigma;
+  template <typename T>
+  bool operator()(const T* s, T* r) const {
+    r[0] = s[6] * inverse_sigma;
+    r[1] = s[7] * inverse_sigma;
     return true;
   }
 };
@@ -213,6 +273,7 @@ struct Smoother::Impl {
   std::vector<StoredPose> poses;
   std::vector<StoredTwist> twists;
   std::map<Stamp, Vector6d> guesses;
+  std::set<std::string> biased;  ///< pose sources whose positions carry the shared slowly varying error
 
   // The guess at a stamp: linear between the neighbouring guesses (yaw along the short way round).
   Vector6d guessAt(Stamp t) const {
@@ -292,6 +353,8 @@ bool Smoother::addTwist(const std::string& source, const TwistMeasurement& measu
   return true;
 }
 
+void Smoother::setPoseBias(const std::string& source) { impl_->biased.insert(source); }
+
 void Smoother::calibrateRsu(const std::string& source, const Eigen::Vector2d& surveyed_position, bool clock) {
   impl_->calibrated.push_back({source, surveyed_position, clock});
 }
@@ -340,11 +403,14 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   const std::size_t n = static_cast<std::size_t>((last - first) / step) + 1;
   SmootherResult result;
   result.states.resize(n);
+  std::vector<std::array<double, kState>> x(n);
   for (std::size_t k = 0; k < n; ++k) {
     result.states[k].stamp = first + static_cast<Stamp>(k) * step;
-    result.states[k].state = impl_->guessAt(result.states[k].stamp);
+    const Vector6d g = impl_->guessAt(result.states[k].stamp);
+    x[k].fill(0.0);
+    for (int i = 0; i < 6; ++i) x[k][static_cast<std::size_t>(i)] = g[i];
   }
-  auto blockOf = [&](std::size_t k) { return result.states[k].state.data(); };
+  auto blockOf = [&](std::size_t k) { return x[k].data(); };
 
   ceres::Problem problem;
   const double dt = toSeconds(step);
@@ -352,18 +418,18 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   inverse_sigma << 1.0 / (o.proc_stddev_position_c * dt), 1.0 / (o.proc_stddev_position_c * dt), 1.0 / (o.proc_stddev_yaw_c * dt),
       1.0 / (o.proc_stddev_yaw_bias_c * dt), 1.0 / (o.proc_stddev_vx_c * dt), 1.0 / (o.proc_stddev_wz_c * dt);
   for (std::size_t k = 0; k + 1 < n; ++k)
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<MotionResidual, 6, 6, 6>(new MotionResidual{dt, o.trapezoid, inverse_sigma}), nullptr,
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<MotionResidual, 6, kState, kState>(new MotionResidual{dt, o.trapezoid, inverse_sigma}), nullptr,
                              blockOf(k), blockOf(k + 1));
   // A state prior (a window's start) replaces the weak pull of the yaw bias to zero.
   bool prior_at_start = false;
   for (const StoredPrior& p : impl_->priors) {
     if (p.stamp < first || p.stamp > last) continue;
     const std::size_t k = std::min(n - 1, static_cast<std::size_t>((p.stamp - first) / step));
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<StatePrior, 6, 6>(new StatePrior(p.prior)), nullptr, blockOf(k));
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<StatePrior, 6, kState>(new StatePrior(p.prior)), nullptr, blockOf(k));
     prior_at_start = prior_at_start || k == 0;
   }
   if (!prior_at_start)
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YawBiasPrior, 1, 6>(new YawBiasPrior{1.0 / std::sqrt(o.initial_yaw_bias_variance)}),
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YawBiasPrior, 1, kState>(new YawBiasPrior{1.0 / std::sqrt(o.initial_yaw_bias_variance)}),
                              nullptr, blockOf(0));
 
   struct Added {
@@ -373,6 +439,7 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     double threshold;  ///< squared whitened norm where the loss starts to down-weight
     int rsu = -1;      ///< the calibrated RSU whose fix it is
     ceres::LossFunctionWrapper* loss = nullptr;
+    bool gated = true;  ///< false: a process model's residual, never left out
   };
   std::vector<Added> added;
   // One block per calibrated RSU, (dx, dy, dyaw, clock offset) starting at 0; without a clock, the
@@ -383,10 +450,15 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   std::vector<int> fixes_of(impl_->calibrated.size(), 0);
   // Robust measurements start with a Cauchy loss at the gate, whose pull fades with the residual, so
   // that a gross fix does not drag its neighbours (twists included) past the gate as well; see below.
-  auto loss = [&](int m) -> std::pair<ceres::LossFunctionWrapper*, double> {
+  // A calibrated RSU's fixes are all off until its calibration is found (0.15 m and 0.5 deg put them
+  // 35 cm off, far beyond a 2 mm fix's gate): they start under a Huber loss, which still pulls, and
+  // turn Cauchy once a first solve has found the calibration.
+  auto loss = [&](int m, bool calibrated = false) -> std::pair<ceres::LossFunctionWrapper*, double> {
     const double delta2 = chiSquareQuantile(m, o.gate_alpha);
     if (!o.robust && !o.estimate_noise) return {nullptr, delta2};
-    return {new ceres::LossFunctionWrapper(o.robust ? new ceres::CauchyLoss(std::sqrt(delta2)) : nullptr, ceres::TAKE_OWNERSHIP), delta2};
+    ceres::LossFunction* inner = nullptr;
+    if (o.robust) inner = calibrated ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(std::sqrt(delta2))) : new ceres::CauchyLoss(std::sqrt(delta2));
+    return {new ceres::LossFunctionWrapper(inner, ceres::TAKE_OWNERSHIP), delta2};
   };
   for (const StoredPose& p : impl_->poses) {
     if (p.stamp < first || p.stamp > last) continue;
@@ -396,33 +468,68 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
       const CalibratedRsu& rsu = impl_->calibrated[calibrated->second];
       auto* f = new CalibratedFixResidual{toSeconds(p.stamp - result.states[k].stamp), p.value[0], p.value[1], rsu.position.x(), rsu.position.y(),
                                           p.whitening.topLeftCorner<2, 2>()};
-      const auto [l, delta2] = loss(2);
+      const auto [l, delta2] = loss(2, true);
       double* block = calibration[calibrated->second].data();
-      added.push_back({problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CalibratedFixResidual, 2, 6, 4>(f), l, blockOf(k), block),
+      added.push_back({problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CalibratedFixResidual, 2, kState, 4>(f), l, blockOf(k), block),
                        &p.source, p.stamp, delta2, static_cast<int>(calibrated->second), l});
       ++fixes_of[calibrated->second];
       ++result.summary.pose_residuals;
       continue;
     }
-    PoseResidual* r = new PoseResidual{toSeconds(p.stamp - result.states[k].stamp), p.m, {}, {}, p.whitening};
+    const bool biased = o.pose_bias && impl_->biased.count(p.source) > 0;
+    PoseResidual* r = new PoseResidual{toSeconds(p.stamp - result.states[k].stamp), biased, p.m, {}, {}, p.whitening};
     for (int j = 0; j < p.m; ++j) r->component[j] = p.component[j], r->value[j] = p.value[j];
     const auto [l, delta2] = loss(p.m);
-    added.push_back({problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PoseResidual, ceres::DYNAMIC, 6>(r, p.m), l, blockOf(k)),
+    added.push_back({problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PoseResidual, ceres::DYNAMIC, kState>(r, p.m), l, blockOf(k)),
                      &p.source, p.stamp, delta2, -1, l});
     ++result.summary.pose_residuals;
   }
   for (std::size_t i = 0; i < impl_->calibrated.size(); ++i)
     if (!clock[i] && fixes_of[i] > 0) problem.SetManifold(calibration[i].data(), new ceres::SubsetManifold(4, {3}));
+  // Per twist source, optionally, its speed scale and yaw-rate bias, with a prior at (1, 0).
+  std::map<std::string, std::array<double, 2>> odometry;
   for (const StoredTwist& t : impl_->twists) {
     if (t.stamp < first || t.stamp > last || n < 2) continue;
     const std::size_t k = std::min(n - 2, static_cast<std::size_t>((t.stamp - first) / step));
-    TwistResidual* r = new TwistResidual{toSeconds(t.stamp - result.states[k].stamp) / dt, t.m, {}, {}, t.whitening};
-    for (int j = 0; j < t.m; ++j) r->component[j] = t.component[j], r->value[j] = t.value[j];
+    const TwistResidual r{toSeconds(t.stamp - result.states[k].stamp) / dt, t.m, {t.component[0], t.component[1]}, {t.value[0], t.value[1]},
+                          t.whitening};
     const auto [l, delta2] = loss(t.m);
-    added.push_back(
-        {problem.AddResidualBlock(new ceres::AutoDiffCostFunction<TwistResidual, ceres::DYNAMIC, 6, 6>(r, t.m), l, blockOf(k), blockOf(k + 1)),
-         &t.source, t.stamp, delta2, -1, l});
+    ceres::ResidualBlockId id;
+    if (o.calibrate_odometry) {
+      auto [it, fresh] = odometry.try_emplace(t.source, std::array<double, 2>{1.0, 0.0});
+      if (fresh)
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<OdometryPrior, 2, 2>(new OdometryPrior{1.0 / o.odometry_scale_sd, 1.0 / o.odometry_yaw_rate_bias_sd}),
+            nullptr, it->second.data());
+      id = problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<CalibratedTwistResidual, ceres::DYNAMIC, kState, kState, 2>(new CalibratedTwistResidual{r}, t.m), l,
+          blockOf(k), blockOf(k + 1), it->second.data());
+    } else {
+      id = problem.AddResidualBlock(new ceres::AutoDiffCostFunction<TwistResidual, ceres::DYNAMIC, kState, kState>(new TwistResidual(r), t.m), l,
+                                    blockOf(k), blockOf(k + 1));
+    }
+    added.push_back({id, &t.source, t.stamp, delta2, -1, l});
     ++result.summary.twist_residuals;
+  }
+
+  // The pose bias: 0 on average with pose_bias_sd, varying over pose_bias_time. How large it is gets
+  // measured on the drive (kBiasSource) where something absolute, the fixes, makes it visible.
+  static const std::string kBiasSource = "pose bias";
+  const bool bias_used = o.pose_bias && !impl_->biased.empty();  // else it stays 0, its prior's mean
+  {
+    const double phi = std::exp(-dt / o.pose_bias_time);
+    const double inverse_sigma = 1.0 / (o.pose_bias_sd * std::sqrt(1.0 - phi * phi));
+    const bool used = bias_used;
+    auto* prior_loss = used ? new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP) : nullptr;
+    const ceres::ResidualBlockId prior_id = problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<BiasPrior, 2, kState>(new BiasPrior{1.0 / o.pose_bias_sd}), prior_loss, blockOf(0));
+    if (used) added.push_back({prior_id, &kBiasSource, result.states[0].stamp, 0.0, -1, prior_loss, false});
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+      auto* l = used ? new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP) : nullptr;
+      const ceres::ResidualBlockId id = problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<BiasProcess, 2, kState, kState>(new BiasProcess{phi, inverse_sigma}), l, blockOf(k), blockOf(k + 1));
+      if (used) added.push_back({id, &kBiasSource, result.states[k].stamp, 0.0, -1, l, false});
+    }
   }
 
   ceres::Solver::Options solver;
@@ -451,6 +558,7 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     global_rsu.clear();
     for (std::size_t i = 0; i < impl_->calibrated.size(); ++i)
       if (fixes_of[i] > 0) global_blocks.push_back(calibration[i].data()), global_rsu.push_back(i);
+    for (auto& [source, block] : odometry) global_blocks.push_back(block.data());
   };
 
   const auto start = std::chrono::steady_clock::now();
@@ -458,6 +566,12 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   ceres::Solve(solver, &problem, &summary);
   result.summary.initial_cost = summary.initial_cost;
   result.summary.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  if (o.robust && summary.IsSolutionUsable() && std::any_of(added.begin(), added.end(), [](const Added& a) { return a.rsu >= 0; })) {
+    for (const Added& a : added)
+      if (a.rsu >= 0) a.loss->Reset(new ceres::CauchyLoss(std::sqrt(a.threshold)), ceres::TAKE_OWNERSHIP);
+    ceres::Solve(solver, &problem, &summary);
+    result.summary.iterations += static_cast<int>(summary.iterations.size()) - 1;
+  }
   // Each source's variance factor: what its covariances are off by, as the drive measures it.
   std::map<std::string, double> factor;
   auto factorOf = [&](const Added& a) {
@@ -474,8 +588,8 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     std::vector<Added> kept;
     for (const Added& a : added) {
       const double f = factorOf(a), sum = whitenedSquared(a);
-      if (!o.robust || sum <= f * a.threshold) {
-        ceres::LossFunction* inner = o.robust ? new ceres::HuberLoss(std::sqrt(f * a.threshold)) : nullptr;
+      if (!o.robust || !a.gated || sum <= f * a.threshold) {
+        ceres::LossFunction* inner = o.robust && a.gated ? new ceres::HuberLoss(std::sqrt(f * a.threshold)) : nullptr;
         a.loss->Reset(new ceres::ScaledLoss(inner, 1.0 / f, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
         kept.push_back(a);
         continue;
@@ -495,7 +609,7 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     // / m) over the median of chi-square(m), so that the few misfits that the Huber loss bounds (a fix
     // on the wrong corner) do not inflate it for all the good ones.
     collectGlobals();
-    const ChainMarginals m = chainMarginals(problem, state_blocks, global_blocks, std::max(1, o.threads));
+    const ChainMarginals m = chainMarginals(problem, state_blocks, global_blocks, std::max(1, o.threads), kState);
     if (!m.ok) break;
     struct Tally {
       std::vector<double> normalised;  ///< r^2 / (redundancy / m)
@@ -519,18 +633,38 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
       for (std::size_t b = 0; b < parameters.size(); ++b) {
         const auto k = state_of.find(parameters[b]);
         if (k == state_of.end()) continue;  // a calibration block: its share is small beside the states'
-        const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> J(jacobians[b], rows, 6);
+        const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, kState, Eigen::RowMajor>> J(jacobians[b], rows, kState);
         hat += (J * m.states[k->second] * J.transpose()).trace();
       }
       double squares = 0.0;
       for (double r : residuals) squares += r * r;
       const double redundancy = (rows - hat / factorOf(a)) / rows;
       if (redundancy < 0.05) continue;  // a residual its states follow almost entirely says little
+      if (a.source == &kBiasSource) continue;  // measured below
       Tally& t = tally[*a.source];
       t.normalised.push_back(squares / redundancy);
       t.m = std::max(t.m, rows);
     }
     bool changed = false;
+    // The bias's size, by expectation-maximisation over the states that show it: the mean of b^2 + its
+    // variance where its variance is well below the size assumed (elsewhere the drive says nothing).
+    if (bias_used) {
+      const double assumed = o.pose_bias_sd * o.pose_bias_sd * (factor.count(kBiasSource) ? factor[kBiasSource] : 1.0);
+      double sum = 0.0;
+      int count = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const double variance = 0.5 * (m.states[k](6, 6) + m.states[k](7, 7));
+        if (variance > 0.25 * assumed) continue;
+        sum += 0.5 * (x[k][6] * x[k][6] + x[k][7] * x[k][7]) + variance;
+        ++count;
+      }
+      if (count >= 50) {
+        const double updated = std::clamp(sum / count / (o.pose_bias_sd * o.pose_bias_sd), 1e-4, 1e4);
+        double& f = factor.try_emplace(kBiasSource, 1.0).first->second;
+        changed = changed || std::abs(updated / f - 1.0) > 0.05;
+        f = updated;
+      }
+    }
     for (auto& [source, t] : tally) {
       if (static_cast<int>(t.normalised.size()) < o.noise_min_measurements) continue;
       const auto middle = t.normalised.begin() + static_cast<std::ptrdiff_t>(t.normalised.size() / 2);
@@ -548,22 +682,26 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   result.summary.termination = terminationName(summary.termination_type);
   result.summary.report = summary.BriefReport();
   result.summary.states = static_cast<int>(n);
-  for (SmoothedState& st : result.states) st.state[2] = wrapAngle(st.state[2]);
+  for (std::size_t k = 0; k < n; ++k) {
+    for (int i = 0; i < 6; ++i) result.states[k].state[i] = x[k][static_cast<std::size_t>(i)];
+    result.states[k].state[2] = wrapAngle(result.states[k].state[2]);
+    result.states[k].pose_bias = Eigen::Vector2d(x[k][6], x[k][7]);
+  }
 
   // What the robust loss still weighs less than its covariance: whitened norms beyond the gate.
   for (const Added& a : added) {
     const double f = factorOf(a), sum = whitenedSquared(a) / f;
-    if (sum > a.threshold) result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(sum), std::sqrt(a.threshold / sum)});
+    if (a.gated && sum > a.threshold) result.summary.down_weighted.push_back({*a.source, a.stamp, std::sqrt(sum), std::sqrt(a.threshold / sum)});
   }
 
   // Marginal covariances of the states and of the calibrations, from the chain's structure (linear in
   // the drive's length; ceres::Covariance's sparse QR took 20 times the solve on a 90 s log).
   collectGlobals();
   const ChainMarginals marginals = result.summary.usable() && (o.covariances || !global_blocks.empty())
-                                      ? chainMarginals(problem, state_blocks, global_blocks, std::max(1, o.threads))
+                                      ? chainMarginals(problem, state_blocks, global_blocks, std::max(1, o.threads), kState)
                                       : ChainMarginals{};
   if (o.covariances && marginals.ok)
-    for (std::size_t k = 0; k < n; ++k) result.states[k].position_covariance = marginals.states[k].topLeftCorner<2, 2>();
+    for (std::size_t k = 0; k < n; ++k) result.states[k].position_covariance = marginals.states[k].topLeftCorner(2, 2);
 
   // The calibrations, with their uncertainty; a block the drive does not determine is said to be so.
   const char* rank_note = "the drive does not determine it: no anchoring pose source (NDT), or too few fixes in too little geometry";
@@ -587,12 +725,31 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
       c.sd_dy = std::sqrt(std::max(0.0, C(at + 1, at + 1)));
       c.sd_dyaw = std::sqrt(std::max(0.0, C(at + 2, at + 2)));
       if (clock[i]) c.sd_clock_offset = std::sqrt(std::max(0.0, C(at + 3, at + 3)));
-      c.observable = c.sd_dx < 1.0 && c.sd_dy < 1.0 && c.sd_dyaw < 0.1 && (!clock[i] || c.sd_clock_offset < 0.1);
+      // Determined: to better than 10 cm, 1 deg and 20 ms, and within what a registry accepts.
+      c.observable = c.sd_dx < 0.1 && c.sd_dy < 0.1 && c.sd_dyaw < M_PI / 180.0 && (!clock[i] || c.sd_clock_offset < 0.02);
       if (!c.observable) c.note = rank_note;
+      if (c.observable && (std::abs(c.dx) > 10.0 || std::abs(c.dy) > 10.0 || std::abs(c.dyaw) > M_PI / 6.0 || std::abs(c.clock_offset) > 1.0)) {
+        c.observable = false;
+        c.note = "implausible: beyond 10 m, 30 deg or 1 s, what a registry accepts; the fixes are not this RSU's, or the drive not this site's";
+      }
     } else {
       c.note = result.summary.usable() ? rank_note : "the solver failed";
     }
     result.calibrations.push_back(c);
+  }
+  std::size_t odometry_offset = 0;
+  for (std::size_t g = 0; g < global_rsu.size(); ++g) odometry_offset += clock[global_rsu[g]] ? 4 : 3;
+  for (const auto& [source, block] : odometry) {
+    OdometryCalibration c;
+    c.source = source;
+    c.speed_scale = block[0];
+    c.yaw_rate_bias = block[1];
+    if (marginals.globals) {
+      c.sd_speed_scale = std::sqrt(std::max(0.0, (*marginals.globals)(odometry_offset, odometry_offset)));
+      c.sd_yaw_rate_bias = std::sqrt(std::max(0.0, (*marginals.globals)(odometry_offset + 1, odometry_offset + 1)));
+    }
+    odometry_offset += 2;
+    result.odometry.push_back(c);
   }
   return result;
 }

@@ -54,7 +54,7 @@ void addSmoothCommand(CLI::App& app) {
     const std::string& out_dir = o.out;
     SmoothOptions options;
     options.replay = replayOptions(o);
-    options.smoother = smootherOptionsFor(options.replay.config.fusion);
+    options.smoother = smootherOptionsFor(options.replay.config, calibrate);
     options.calibrate_rsus = calibrate;
     options.window = window;
     options.window_step = window_step;
@@ -106,6 +106,9 @@ void addSmoothCommand(CLI::App& app) {
       std::printf("  fixed lag: %d windows of %.1f s every %.2f s; each solved in %.1f ms on average, %.1f ms at most (the latency it adds)\n",
                   r.fixed_lag->windows, r.fixed_lag->window, r.fixed_lag->step, 1e3 * r.fixed_lag->mean_solve_seconds,
                   1e3 * r.fixed_lag->max_solve_seconds);
+    for (const auto& o : r.odometry)
+      std::printf("  odometry %s: speed scale %.5f (sd %.5f), yaw-rate bias %+.5f rad/s (sd %.5f)\n", o.source.c_str(), o.speed_scale, o.sd_speed_scale,
+                  o.yaw_rate_bias, o.sd_yaw_rate_bias);
     if (!r.summary.noise.empty()) {
       std::printf("  noise measured on the drive (standard deviation / the messages' own):");
       for (const auto& n : r.summary.noise) std::printf(" %s %.3g", n.source.c_str(), n.scale);

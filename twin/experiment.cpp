@@ -128,7 +128,7 @@ void runJob(Job& job) {
   if (job.smooth || job.calibrate) {
     replay::SmoothOptions so;
     so.replay = options;
-    so.smoother = replay::smootherOptionsFor(job.config.fusion);
+    so.smoother = replay::smootherOptionsFor(job.config, job.calibrate);
     so.calibrate_rsus = job.calibrate;
     const replay::SmoothResult s = replay::smoothLog(job.log, so);
     r = s.filter;

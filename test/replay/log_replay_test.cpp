@@ -254,3 +254,36 @@ TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {
 
 }  // namespace
 }  // namespace coloc::replay
+
+#include "coloc/replay/log_smoother.hpp"
+
+namespace coloc::replay {
+namespace {
+
+// The configuration file's smoother section and the library's SmootherOptions start from the same
+// values: a user of either gets the same smoother.
+TEST(SmootherConfiguration, TheFilesDefaultsAreTheLibrarysDefaults) {
+  const smoother::SmootherOptions library;
+  const pipeline::Config defaults;
+  const smoother::SmootherOptions file = smootherOptionsFor(defaults);
+  EXPECT_EQ(file.rate, library.rate);
+  EXPECT_EQ(file.proc_stddev_yaw_c, library.proc_stddev_yaw_c);
+  EXPECT_EQ(file.proc_stddev_vx_c, library.proc_stddev_vx_c);
+  EXPECT_EQ(file.proc_stddev_wz_c, library.proc_stddev_wz_c);
+  EXPECT_EQ(file.proc_stddev_position_c, library.proc_stddev_position_c);
+  EXPECT_EQ(file.proc_stddev_yaw_bias_c, library.proc_stddev_yaw_bias_c);
+  EXPECT_EQ(file.initial_yaw_bias_variance, library.initial_yaw_bias_variance);
+  EXPECT_EQ(file.gate_alpha, library.gate_alpha);
+  EXPECT_EQ(file.robust, library.robust);
+  EXPECT_EQ(file.estimate_noise, library.estimate_noise);
+  EXPECT_EQ(file.calibrate_odometry, library.calibrate_odometry);
+  EXPECT_EQ(file.odometry_scale_sd, library.odometry_scale_sd);
+  EXPECT_EQ(file.odometry_yaw_rate_bias_sd, library.odometry_yaw_rate_bias_sd);
+  EXPECT_EQ(file.pose_bias, library.pose_bias);
+  EXPECT_EQ(file.pose_bias_time, library.pose_bias_time);
+  // Calibrating RSUs turns the pose bias on (pose_bias: when_calibrating).
+  EXPECT_TRUE(smootherOptionsFor(defaults, true).pose_bias);
+}
+
+}  // namespace
+}  // namespace coloc::replay

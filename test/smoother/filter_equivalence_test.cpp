@@ -41,6 +41,7 @@ TEST(SmootherAndFilter, OnALinearGaussianDriveTheSmoothersLastStateIsTheFilters)
   o.trapezoid = false;
   o.robust = false;
   o.estimate_noise = false;  // the filter takes the covariances as given
+  o.calibrate_odometry = false;  // and the odometry as it reads
   o.proc_stddev_position_c = 1e-4;  // the filter's are 0; a batch problem needs a finite weight
   o.proc_stddev_yaw_bias_c = 1e-6;
   Smoother smoother(o);

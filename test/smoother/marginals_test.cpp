@@ -45,7 +45,7 @@ TEST(ChainMarginals, EqualCeresOwnCovarianceOnAChainWithGlobalBlocks) {
 
   std::vector<double*> chain;
   for (auto& s : states) chain.push_back(s.data());
-  const ChainMarginals fast = chainMarginals(problem, chain, {global.data(), held.data()}, 1);
+  const ChainMarginals fast = chainMarginals(problem, chain, {global.data(), held.data()}, 1, 6);
   ASSERT_TRUE(fast.ok);
   ASSERT_TRUE(fast.globals);
 
@@ -84,7 +84,7 @@ TEST(ChainMarginals, AGlobalBlockTheProblemDoesNotDetermineIsReportedUndetermine
   }
   std::vector<double*> chain;
   for (auto& s : states) chain.push_back(s.data());
-  const ChainMarginals m = chainMarginals(problem, chain, {global.data()}, 1);
+  const ChainMarginals m = chainMarginals(problem, chain, {global.data()}, 1, 6);
   EXPECT_FALSE(m.ok);
   EXPECT_FALSE(m.globals);
 }

@@ -73,6 +73,27 @@ struct PipelineSection {
   double speed_scale_memory = 500.0;  ///< m of travel over which old comparisons fade
 };
 
+/// The Ceres smoother of recorded logs (coloc smooth, the experiment's smoother column). Its rate,
+/// process noise and gate follow the filter's (fusion section); these are its own.
+struct SmootherSection {
+  /// Measure each source's noise on the drive instead of taking the messages' covariances as given.
+  bool estimate_noise = true;
+  /// Estimate each odometry's speed scale and yaw-rate bias with the trajectory (twists then enter
+  /// as the log has them, not as the pipeline rescaled them).
+  bool calibrate_odometry = true;
+  double odometry_scale_sd = 0.05;          ///< prior standard deviation of the scale around 1
+  double odometry_yaw_rate_bias_sd = 0.01;  ///< rad/s, prior standard deviation of the bias around 0
+  /// When map-matching poses (NDT) carry a slowly varying bias of their own, estimated with the
+  /// states: when calibrating RSUs (they are anchored by NDT, and their uncertainty must include
+  /// NDT's bias), always, or never.
+  enum class PoseBias { kWhenCalibrating, kAlways, kNever } pose_bias = PoseBias::kWhenCalibrating;
+  double pose_bias_time = 2.0;  ///< s, the bias's correlation time
+  /// Freedom the filter's motion model does not have, which a batch problem needs: a random walk of
+  /// the position and of the yaw bias.
+  double proc_stddev_position_c = 0.02;  ///< m/s
+  double proc_stddev_yaw_bias_c = 1e-4;  ///< rad/s
+};
+
 /// The live node's topics (ROS 2 names; DDS adds "rt") and QoS.
 struct LiveSection {
   std::string scan_topic = "/points";
@@ -94,6 +115,7 @@ struct Config {
   MessageConfig messages;
   std::map<std::string, InputConfig> inputs;  ///< by topic
   ReplayConfig replay;
+  SmootherSection smoother;
   LiveSection live;
 };
 

@@ -89,8 +89,9 @@ class Pipeline {
   void onEstimate(std::function<void(const fusion::Estimate&)> callback);
   /// Every pose measurement handed to the filter (NDT results, fixes, other sources), for plots.
   void onPoseInput(std::function<void(const std::string& source, const PoseMeasurement&)> callback);
-  /// Every twist handed to the filter, as handed (its speed scaled by what NDT taught), for smoothers.
-  void onTwistInput(std::function<void(const std::string& source, const TwistMeasurement&)> callback);
+  /// Every twist handed to the filter, as handed (its speed scaled by what NDT taught so far) and as
+  /// received, for smoothers.
+  void onTwistInput(std::function<void(const std::string& source, const TwistMeasurement& handed, const TwistMeasurement& received)> callback);
   /// Every rejection, as one line naming the input and the reason.
   void onRejection(std::function<void(const std::string& line)> callback);
 

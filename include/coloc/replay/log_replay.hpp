@@ -55,6 +55,7 @@ struct ReplayResult {
   /// the fix checks and the speed scale), and the filter's state at every tick, for a smoother.
   std::vector<std::pair<std::string, PoseMeasurement>> filter_poses;
   std::vector<std::pair<std::string, TwistMeasurement>> filter_twists;
+  std::vector<std::pair<std::string, TwistMeasurement>> received_twists;  ///< the same twists as the log has them
   std::vector<std::pair<Stamp, Vector6d>> fused_states;
   std::vector<Matrix6d> fused_state_covariances;  ///< beside fused_states
   double speed_scale = 1.0;           ///< the odometry's speed scale learned from NDT

@@ -15,8 +15,8 @@ namespace coloc::replay {
 
 struct SmoothOptions {
   ReplayOptions replay;
-  /// The smoother's settings; rate, process noise and the robust loss's alpha follow the filter's
-  /// configuration (replay.config.fusion) unless changed after `smootherOptionsFor`.
+  /// The smoother's settings, as `smootherOptionsFor` makes them from the configuration
+  /// (replay.config), unless changed after.
   smoother::SmootherOptions smoother;
   /// Estimate each registered RSU's survey and clock offsets with the trajectory (its fixes must be
   /// anchored by NDT or another pose source).
@@ -35,9 +35,9 @@ struct FixedLagReport {
   double mean_solve_seconds = 0.0, max_solve_seconds = 0.0;
 };
 
-/// The smoother's settings that match a filter configuration: tick rate, process noise, yaw-bias
-/// prior and the gate's alpha (0, no gate, turns the robust loss off).
-smoother::SmootherOptions smootherOptionsFor(const fusion::EkfConfig& filter);
+/// The smoother's settings of a configuration: the filter's tick rate, process noise, yaw-bias prior
+/// and gate's alpha (0, no gate, turns the robust loss off), and the smoother section's own.
+smoother::SmootherOptions smootherOptionsFor(const pipeline::Config& config, bool calibrating_rsus = false);
 
 struct SmoothResult {
   ReplayResult filter;                         ///< the replay, with the filter's own errors
@@ -48,6 +48,7 @@ struct SmoothResult {
   double wall_seconds = 0.0;                   ///< the smoothing alone
   /// Per RSU id, with calibrate_rsus. Observable ones can go into the next drives' registry.
   std::map<std::string, smoother::RsuCalibration> calibrations;
+  std::vector<smoother::OdometryCalibration> odometry;  ///< per twist source, when estimated
   std::optional<FixedLagReport> fixed_lag;     ///< in fixed-lag mode
   std::vector<ErrorSample> filter_errors_matched;  ///< the filter's errors at the stamps the smoother gave
   rsu_client::RsuRegistry registry;            ///< the registry used; `calibratedRegistry` adds the findings

@@ -41,6 +41,23 @@ struct SmootherOptions {
   /// covariances are claims: the twin's odometry says 0.2 m/s and is 0.05 m/s good, the published fix
   /// sigma is 12 cm for fixes millimetres good. Sources with fewer measurements keep their covariances.
   bool estimate_noise = true;
+  /// Map-matching poses (NDT) err slowly: the same centimetre or two for seconds, not afresh each
+  /// scan. With this, sources named by setPoseBias measure the position plus a shared bias (bx, by), a
+  /// first-order Gauss-Markov process of pose_bias_time, estimated with the states, whose size is
+  /// measured where something absolute (the fixes) shows it. Without it, noise estimation takes such
+  /// a source's scan-to-scan scatter for its whole error, and what it anchors (an RSU's calibration)
+  /// comes out with an uncertainty too small. Off by default: on the twin it halves the error within
+  /// RSU coverage but raises it elsewhere, as NDT's bias there is smaller than the size measured near
+  /// the RSU, which the model applies everywhere (see README).
+  bool pose_bias = false;
+  double pose_bias_sd = 0.05;   ///< m, the start before it is measured
+  double pose_bias_time = 2.0;  ///< s
+  /// Estimate each twist source's speed scale and yaw-rate bias with the trajectory (the odometry
+  /// reads scale * vx and wz + bias), each with a prior at (1, 0) of these standard deviations: an
+  /// odometry whose white noise is measured small must not carry its systematic error into the track.
+  bool calibrate_odometry = true;
+  double odometry_scale_sd = 0.05;
+  double odometry_yaw_rate_bias_sd = 0.01;  ///< rad/s
   int noise_rounds = 4;
   int noise_min_measurements = 20;
   int max_iterations = 50;
@@ -91,9 +108,17 @@ struct RsuCalibration {
   std::string note;  ///< why not, when not; what was held, when something was
 };
 
+/// A twist source's calibration as estimated (SmootherOptions::calibrate_odometry).
+struct OdometryCalibration {
+  std::string source;
+  double speed_scale = 1.0, yaw_rate_bias = 0.0;  ///< the odometry reads scale * vx, wz + bias (rad/s)
+  double sd_speed_scale = 0.0, sd_yaw_rate_bias = 0.0;
+};
+
 struct SmoothedState {
   Stamp stamp = 0;
   Vector6d state = Vector6d::Zero();  ///< [x, y, yaw, yaw_bias, vx, wz]
+  Eigen::Vector2d pose_bias = Eigen::Vector2d::Zero();  ///< m, what setPoseBias sources were off by
   std::optional<Eigen::Matrix2d> position_covariance;
 };
 
@@ -101,6 +126,7 @@ struct SmootherResult {
   std::vector<SmoothedState> states;
   SmootherSummary summary;
   std::vector<RsuCalibration> calibrations;  ///< one per calibrateRsu, in that order
+  std::vector<OdometryCalibration> odometry;  ///< one per twist source, with calibrate_odometry
 };
 
 class Smoother {
@@ -122,6 +148,8 @@ class Smoother {
   /// A prior on the state at `stamp` (a fixed-lag window's start: what the filter or an earlier window
   /// knew there). Its covariance must be positive definite on the six states.
   bool addPrior(Stamp stamp, const Vector6d& state, const Matrix6d& covariance);
+  /// The source's positions carry the slowly varying error of map matching (SmootherOptions::pose_bias).
+  void setPoseBias(const std::string& source);
   /// Estimates the survey and clock offsets of the RSU whose fixes come as `source`, jointly with the
   /// trajectory: its fixes are corrected by them before they are compared with the state. Other pose
   /// sources (NDT) anchor the trajectory; without them nothing here is observable, and is said so.
