@@ -8,22 +8,14 @@
 
 #include "coloc/fusion/localizer.hpp"
 #include "coloc/smoother/smoother.hpp"
+#include "measurements.hpp"
 
 namespace coloc::smoother {
 namespace {
 
-constexpr Stamp kStart = 1'700'000'000'000'000'000LL;
-constexpr Duration kTick = 20'000'000;
-
-PoseMeasurement pose(Stamp stamp, double x, double y, double yaw, double var_xy, double var_yaw) {
-  PoseMeasurement m;
-  m.stamp = stamp;
-  m.pose.position = {x, y, 0.0};
-  m.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, yaw);
-  m.covariance = Matrix6d::Zero();
-  m.covariance.diagonal() << var_xy, var_xy, kInfinity, kInfinity, kInfinity, var_yaw;
-  return m;
-}
+using testing::kStart;
+using testing::kTick;
+using testing::planarPose;
 
 TEST(SmootherAndFilter, OnALinearGaussianDriveTheSmoothersLastStateIsTheFilters) {
   fusion::EkfConfig c;
@@ -34,7 +26,7 @@ TEST(SmootherAndFilter, OnALinearGaussianDriveTheSmoothersLastStateIsTheFilters)
   c.twist_gate_alpha = 0.0;
   fusion::Localizer filter(c);
   const fusion::SourceId ndt = filter.addPoseSource("ndt"), rsu = filter.addPoseSource("rsu"), odom = filter.addTwistSource("odom");
-  filter.initialize(pose(kStart, 0.0, 0.0, 0.0, 0.01, 1e-4));
+  filter.initialize(planarPose(kStart, 0.0, 0.0, 0.0, 0.01, 1e-4));
   const fusion::Estimate start = *filter.estimate();
 
   SmootherOptions o;
@@ -69,12 +61,12 @@ TEST(SmootherAndFilter, OnALinearGaussianDriveTheSmoothersLastStateIsTheFilters)
     ASSERT_TRUE(filter.feedTwist(odom, tw).applied());
     ASSERT_TRUE(smoother.addTwist("odom", tw));
     if (k % 5 == 0 && k > 0) {
-      const PoseMeasurement p = pose(t, x + 0.1 * n01(rng), 0.1 * n01(rng), 0.005 * n01(rng), 0.01, 2.5e-5);
+      const PoseMeasurement p = planarPose(t, x + 0.1 * n01(rng), 0.1 * n01(rng), 0.005 * n01(rng), 0.01, 2.5e-5);
       ASSERT_TRUE(filter.feedPose(ndt, p).applied());
       ASSERT_TRUE(smoother.addPose("ndt", p));
     }
     if (k % 5 == 2 && k > 100 && k < 150) {  // a second of roadside fixes, x and y only
-      PoseMeasurement f = pose(t, x + 0.01 * n01(rng), 0.01 * n01(rng), 0.0, 1e-4, 1.0);
+      PoseMeasurement f = planarPose(t, x + 0.01 * n01(rng), 0.01 * n01(rng), 0.0, 1e-4, 1.0);
       f.covariance(5, 5) = kInfinity;
       ASSERT_TRUE(filter.feedPose(rsu, f).applied());
       ASSERT_TRUE(smoother.addPose("rsu", f));
