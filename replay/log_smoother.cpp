@@ -193,6 +193,7 @@ std::string SmoothResult::summaryJson(const std::string& log) const {
     auto& noise = j["noise_scale"] = nlohmann::ordered_json::object();  // measured sd / the covariances' sd
     for (const smoother::NoiseScale& n : summary.noise) noise[n.source] = n.scale;
   }
+  if (summary.pose_bias_sd) j["pose_bias_sd_m"] = *summary.pose_bias_sd;
   auto& down = j["down_weighted"] = nlohmann::ordered_json::array();
   for (const smoother::DownWeighted& d : summary.down_weighted)
     down.push_back({{"source", d.source}, {"stamp", formatSeconds(d.stamp)}, {"mahalanobis", d.mahalanobis}, {"weight", d.weight}});

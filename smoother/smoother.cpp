@@ -676,7 +676,9 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     }
     if (!changed) break;
   }
-  for (const auto& [source, f] : factor) result.summary.noise.push_back({source, std::sqrt(f)});
+  for (const auto& [source, f] : factor)
+    if (source != kBiasSource) result.summary.noise.push_back({source, std::sqrt(f)});
+  if (bias_used) result.summary.pose_bias_sd = o.pose_bias_sd * std::sqrt(factor.count(kBiasSource) ? factor.at(kBiasSource) : 1.0);
   result.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.summary.final_cost = summary.final_cost;
   result.summary.termination = terminationName(summary.termination_type);

@@ -114,6 +114,7 @@ void addSmoothCommand(CLI::App& app) {
       for (const auto& n : r.summary.noise) std::printf(" %s %.3g", n.source.c_str(), n.scale);
       std::printf("\n");
     }
+    if (r.summary.pose_bias_sd) std::printf("  NDT's slowly varying bias, as measured where fixes show it: %.1f cm\n", 100 * *r.summary.pose_bias_sd);
     for (std::size_t i = 0; i < r.summary.down_weighted.size() && i < 5; ++i) {
       const auto& d = r.summary.down_weighted[i];
       std::printf("    %s stamped %s: %.1f sigma, weight %.3f\n", d.source.c_str(), formatSeconds(d.stamp).c_str(), d.mahalanobis, d.weight);

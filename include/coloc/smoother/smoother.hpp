@@ -88,6 +88,7 @@ struct SmootherSummary {
   int states = 0, pose_residuals = 0, twist_residuals = 0;
   std::vector<DownWeighted> down_weighted;
   std::vector<NoiseScale> noise;  ///< per source whose noise was measured (estimate_noise)
+  std::optional<double> pose_bias_sd;  ///< m, the pose bias's size as measured (pose_bias)
   bool usable() const { return termination == "CONVERGENCE" || termination == "NO_CONVERGENCE"; }
 };
 
