@@ -198,6 +198,27 @@ double robustFixVariance(const std::vector<Eigen::Vector2d>& errors, const std::
   return sigma * sigma;
 }
 
+// The odometry's error as the filter gets it, per component: the speed after the scale the pipeline
+// learns from NDT (here the least-squares scale against the truth), the yaw rate as it is (the
+// filter has no gyro bias state, so a bias is part of its error). Samples at standstill say nothing of
+// the scale and are left out.
+Eigen::Vector2d odometryVariance(const std::vector<Eigen::Vector4d>& samples, const std::string& site) {
+  double mt = 0.0, tt = 0.0;
+  for (const Eigen::Vector4d& s : samples)
+    if (s[1] > 0.5) mt += s[0] * s[1], tt += s[1] * s[1];
+  if (tt <= 0.0) throw Error(site + ": the noise calibration drive never moved: no odometry covariance to estimate");
+  const double scale = mt / tt;
+  double speed = 0.0, yaw_rate = 0.0;
+  int n = 0;
+  for (const Eigen::Vector4d& s : samples) {
+    if (s[1] <= 0.5) continue;
+    speed += std::pow(s[0] / scale - s[1], 2);
+    yaw_rate += std::pow(s[2] - s[3], 2);
+    ++n;
+  }
+  return {speed / n, yaw_rate / n};
+}
+
 }  // namespace
 
 std::string ExperimentRun::label() const {
@@ -230,8 +251,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     double rsu_height = 0.0, speed = 0.0;
   };
   // The calibration drives: their own seeds, far from the trials'.
-  constexpr int kCalibrationTrial = 500, kNextTrial = 501;
+  constexpr int kNoiseTrial = 499, kCalibrationTrial = 500, kNextTrial = 501;
+  // First, per site, a drive that is never evaluated: on it the fixes' variance and the odometry's
+  // covariance are measured against ground truth, as a surveyed vehicle would measure them.
   std::vector<Drive> drives;
+  for (std::size_t s = 0; s < config.sites.size(); ++s) drives.push_back({s, kNoiseTrial, kNoiseCalibrationDrive, 0.0, 0.0});
   for (std::size_t s = 0; s < config.sites.size(); ++s)
     for (int t = 0; t < config.trials; ++t) drives.push_back({s, t, "", 0.0, 0.0});
   if (config.sweeps)
@@ -255,7 +279,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     scenarios.push_back(siteScenario(site, config.lidars));
     results.sites.push_back(siteInfo(scenarios.back()));
   }
-  std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU topic -> variance
+  std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU id -> variance
+  std::vector<Eigen::Vector2d> twist_variance(config.sites.size(), Eigen::Vector2d::Zero());  // per site: vx, wz
 
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
   struct Recorded {
@@ -284,12 +309,13 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       r.variant = buf;
       std::snprintf(buf, sizeof buf, "_speed_%.0f", drive.speed);
       r.name += buf;
-    } else if (!drive.variant.empty()) {  // the calibration drives: every RSU miscalibrated but on the perfect one
+    } else if (!drive.variant.empty()) {  // the calibration drives: every RSU miscalibrated on two of them
       r.variant = drive.variant;
-      r.name = r.scenario.name + (drive.variant == kCalibrationDrive ? "/calibration_drive"
-                                  : drive.variant == kNextPerfect    ? "/next_drive_perfect_rsu"
-                                                                     : "/next_drive_miscalibrated");
-      if (drive.variant != kNextPerfect)
+      r.name = r.scenario.name + (drive.variant == kNoiseCalibrationDrive ? "/noise_calibration_drive"
+                                  : drive.variant == kCalibrationDrive    ? "/calibration_drive"
+                                  : drive.variant == kNextPerfect         ? "/next_drive_perfect_rsu"
+                                                                          : "/next_drive_miscalibrated");
+      if (drive.variant == kCalibrationDrive || drive.variant == kNextMiscalibrated)
         for (sim::ScenarioRsu& rsu : r.scenario.rsus) {
           rsu.survey_error = Eigen::Vector3d(config.calibration_error[0], config.calibration_error[1], config.calibration_error[2] * M_PI / 180.0);
           rsu.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
@@ -347,6 +373,15 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.map = maps[drive.site];
       job.config = fuse;
       job.rsu_positions = rsu_positions;
+      if (config.twist_covariance_estimated) {
+        pipeline::InputConfig twist;
+        twist.role = pipeline::InputRole::kTwist;
+        Vector6d diagonal = Vector6d::Constant(kInfinity);
+        diagonal[0] = twist_variance[drive.site][0];
+        diagonal[5] = twist_variance[drive.site][1];
+        twist.covariance_diagonal = diagonal;
+        job.config.inputs["/vehicle/twist"] = twist;
+      }
       for (const sim::ScenarioRsu& r : scenario.rsus) {
         pipeline::InputConfig input;
         const std::string topic = rsu_client::fixTopic(r.id);
@@ -369,27 +404,33 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       }
       return job;
     };
-    // The fixes' variance under each way of setting it; the estimate comes from the site's first drive.
+    // The fixes' variance under each way of setting it; the estimate comes from the site's noise calibration drive.
     auto varianceFor = [&](RsuCovariance how, const std::string& lidar) -> std::optional<double> {
       const rsu_client::LidarModel* model = rsu_client::findLidarModel(lidar);
       if (how == RsuCovariance::kStandardDeviation) return model->sigma * model->sigma;
       if (how == RsuCovariance::kEstimated) {
-        auto& measured = measured_variance[drive.site];
+        const auto& measured = measured_variance[drive.site];
         for (const sim::ScenarioRsu& r : scenario.rsus)
           if (r.lidar_model == lidar) {
-            if (!measured.count(r.id)) {
-              const auto errors = summary.fix_errors.find(r.id);
-              measured[r.id] = robustFixVariance(errors == summary.fix_errors.end() ? std::vector<Eigen::Vector2d>{} : errors->second, r.id);
-              results.estimated_variance[scenario.name + " " + lidar] = measured[r.id];
-            }
-            return measured.at(r.id);
+            const auto found = measured.find(r.id);
+            if (found == measured.end()) throw Error("RSU " + r.id + ": no fix variance measured on the noise calibration drive");
+            return found->second;
           }
       }
       return std::nullopt;  // the fix's own covariance, as published
     };
     const RsuCovariance main_covariance = config.rsu_covariance;
     std::vector<Job> jobs;
-    if (drive.variant.empty()) {
+    if (drive.variant == kNoiseCalibrationDrive) {
+      for (const sim::ScenarioRsu& r : scenario.rsus) {
+        const auto errors = summary.fix_errors.find(r.id);
+        measured_variance[drive.site][r.id] =
+            robustFixVariance(errors == summary.fix_errors.end() ? std::vector<Eigen::Vector2d>{} : errors->second, r.id);
+        results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
+      }
+      twist_variance[drive.site] = odometryVariance(summary.odometry, scenario.name);
+      results.estimated_twist_variance[scenario.name] = twist_variance[drive.site];
+    } else if (drive.variant.empty()) {
       jobs.push_back(makeJob("", 0.0, 0.0, "", std::nullopt));
       for (const std::string& lidar : config.lidars) {
         for (double delay : config.delays)

@@ -438,13 +438,24 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
        << ".svg)\n\n";
   if (c.sweeps) md << "## Sweeps beyond the paper (" << std::min(c.sweep_trials, c.trials) << " trial(s) per site, both sites pooled)\n\n" << sweeps_md.str() << "\n";
   if (!results.estimated_variance.empty()) {
-    md << "Fix variances estimated on each site's first drive (robust, from the median absolute error per axis): ";
+    md << "Measured on each site's noise calibration drive, which is not evaluated: the fixes' variance (robust, from the median "
+          "absolute error per axis): ";
     bool first = true;
     for (const auto& [key, v] : results.estimated_variance) {
       md << (first ? "" : ", ") << key << fmt(" %.2e m^2", v) << fmt(" (sigma %.1f cm)", 100 * std::sqrt(v));
       first = false;
     }
-    md << ".\n\n";
+    md << ".";
+    if (c.twist_covariance_estimated) {
+      md << " The odometry's, which the filter then uses: ";
+      first = true;
+      for (const auto& [site, v] : results.estimated_twist_variance) {
+        md << (first ? "" : ", ") << site << fmt(" speed %.3f m/s", std::sqrt(v[0])) << fmt(", yaw rate %.4f rad/s", std::sqrt(v[1]));
+        first = false;
+      }
+      md << " (the messages say 0.2 m/s and 0.1 rad/s).";
+    }
+    md << "\n\n";
   }
   md << "## Run time\n\n"
      << fmt("%.0f s in all", tm.total) << fmt(": survey maps %.1f s, ", tm.survey) << fmt("simulating %.0f s of driving ", tm.driven_seconds) << fmt("%.1f s ", tm.simulation)

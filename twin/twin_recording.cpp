@@ -225,6 +225,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     bag.write("/ground_truth/odom", at(t), gt_bytes.data(), gt_bytes.size());
     if (k % 2 == 0) {  // 50 Hz odometry, logged 2 ms after sensing
       const sim::OdometrySample o = sim::measureOdometry(truth, odometry_noise, rng);
+      summary.odometry.emplace_back(o.speed, truth.speed, o.yaw_rate, truth.yaw_rate);
       io::StampedTwist tw;
       tw.header = {at(t), "base_link"};
       tw.measurement.linear = {o.speed, 0, 0};

@@ -4,6 +4,7 @@
 // configuration (NDT only; NDT + each LiDAR's fixes; the same under each network cell), with the fused
 // pose as NDT's initial guess as on a vehicle. The configurations of a trial share the drive and the
 // scans, so their comparison is paired.
+#include <Eigen/Core>
 #include <functional>
 #include <map>
 #include <string>
@@ -40,6 +41,7 @@ struct CalibrationResult {
 };
 inline constexpr const char* kSmootherVariant = "smoother";
 inline constexpr const char* kCalibrationDrive = "calibration drive";
+inline constexpr const char* kNoiseCalibrationDrive = "noise calibration drive";
 inline constexpr const char* kNextMiscalibrated = "next drive, registry as surveyed";
 inline constexpr const char* kNextCalibrated = "next drive, calibrated registry";
 inline constexpr const char* kNextPerfect = "next drive, perfect RSU";
@@ -62,8 +64,10 @@ struct ExperimentResults {
   std::vector<SiteInfo> sites;
   std::vector<ExperimentRun> runs;
   ExperimentTiming timing;
-  /// "SITE LIDAR" -> the fixes' variance estimated on the site's first drive, m^2 (when used).
+  /// "SITE LIDAR" -> the fixes' variance estimated on the site's noise calibration drive, m^2.
   std::map<std::string, double> estimated_variance;
+  /// Per site: the odometry's variance of speed ((m/s)^2) and yaw rate ((rad/s)^2) on that drive.
+  std::map<std::string, Eigen::Vector2d> estimated_twist_variance;
   std::vector<CalibrationResult> calibrations;
   std::string work_dir;  ///< the recordings
 };

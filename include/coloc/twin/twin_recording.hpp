@@ -36,6 +36,8 @@ struct TwinRecordingSummary {
   std::string map_dir;  ///< where the map the log goes with is
   /// Per RSU id: each fix's error (x, y) against ground truth, whether the link delivered it or not.
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
+  /// Each odometry sample: (measured speed, true speed, measured yaw rate, true yaw rate).
+  std::vector<Eigen::Vector4d> odometry;
 };
 
 /// Throws coloc::Error if the output cannot be written.
