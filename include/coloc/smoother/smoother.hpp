@@ -3,10 +3,12 @@
 // the filter's tick rate with the filter's motion model (x, y, yaw, yaw bias, vx, wz) as motion
 // residuals weighted by its process noise; poses are residuals with their full covariance on the
 // components they measure (an infinite variance leaves its component out exactly), each at its own
-// stamp by propagating the state before it; twists likewise. A Huber loss whose scale is the filter's
-// gate, then that gate applied with hindsight at the robust solution, replace the filter's hard gate,
-// and what they down-weighted or left out is reported. Ceres solves it; its summary and the
-// marginal covariances of the positions come back with the states. Depends on core and Ceres only.
+// stamp by propagating the state before it; twists likewise. The filter's hard gate becomes a Cauchy
+// loss at the gate, the gate applied with hindsight at that solution, and a Huber loss at the gate for
+// what passed; what was down-weighted or left out is reported. Each source's noise, the odometry's
+// calibration and, optionally, a slow bias of map-matching poses and RSU calibrations are estimated
+// with the states. Ceres solves it; its summary and the marginal covariances come back with the
+// states. Depends on core and Ceres only.
 #include <memory>
 #include <optional>
 #include <string>
