@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 
@@ -42,6 +43,16 @@ T wrapped(const T& angle) {
   using std::cos;
   using std::sin;
   return atan2(sin(angle), cos(angle));
+}
+
+// r = L e over the first m components, L lower triangular (the inverse of the measurement's
+// covariance factor): a residual whitened by its covariance.
+template <typename T, typename Lower>
+void whiten(const Lower& lower, const T* e, int m, T* r) {
+  for (int i = 0; i < m; ++i) {
+    r[i] = T(0.0);
+    for (int j = 0; j <= i; ++j) r[i] += lower(i, j) * e[j];
+  }
 }
 
 struct MotionResidual {
@@ -95,15 +106,13 @@ struct PoseResidual {
       if (biased && component[j] < 2) e[j] += s[6 + component[j]];
       if (component[j] == 2) e[j] = wrapped(e[j]);
     }
-    for (int i = 0; i < m; ++i) {
-      r[i] = T(0.0);
-      for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
-    }
+    whiten(whitening, e, m, r);
     return true;
   }
 };
 
-// A measurement of vx and/or wz at a fraction `w` of the way from one state to the next.
+// A measurement of vx and/or wz at a fraction `w` of the way from one state to the next, read by an
+// odometry of speed scale `scale` and yaw-rate bias `bias` (1 and 0 unless calibrated).
 struct TwistResidual {
   double w;
   int m;
@@ -111,33 +120,28 @@ struct TwistResidual {
   double value[2];
   Eigen::Matrix2d whitening;
   template <typename T>
-  bool operator()(const T* a, const T* b, T* r) const {
+  void residual(const T* a, const T* b, const T& scale, const T& bias, T* r) const {
     T e[2];
-    for (int j = 0; j < m; ++j) e[j] = (1.0 - w) * a[component[j]] + w * b[component[j]] - value[j];
-    for (int i = 0; i < m; ++i) {
-      r[i] = T(0.0);
-      for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
+    for (int j = 0; j < m; ++j) {
+      const int c = component[j];
+      const T state = (1.0 - w) * a[c] + w * b[c];
+      e[j] = (c == 4 ? scale * state : state + bias) - value[j];
     }
+    whiten(whitening, e, m, r);
+  }
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    residual(a, b, T(1.0), T(0.0), r);
     return true;
   }
 };
 
-// A twist through its source's calibration o = (speed scale, yaw-rate bias): the odometry reads
-// scale * vx and wz + bias.
+// A twist through its source's calibration o = (speed scale, yaw-rate bias).
 struct CalibratedTwistResidual {
   TwistResidual twist;
   template <typename T>
   bool operator()(const T* a, const T* b, const T* o, T* r) const {
-    T e[2];
-    for (int j = 0; j < twist.m; ++j) {
-      const int c = twist.component[j];
-      const T state = (1.0 - twist.w) * a[c] + twist.w * b[c];
-      e[j] = (c == 4 ? o[0] * state : state + o[1]) - twist.value[j];
-    }
-    for (int i = 0; i < twist.m; ++i) {
-      r[i] = T(0.0);
-      for (int j = 0; j <= i; ++j) r[i] += twist.whitening(i, j) * e[j];
-    }
+    twist.residual(a, b, o[0], o[1], r);
     return true;
   }
 };
@@ -207,10 +211,7 @@ struct StatePrior {
     T e[6];
     for (int j = 0; j < 6; ++j) e[j] = s[j] - mean[j];
     e[2] = wrapped(e[2]);
-    for (int i = 0; i < 6; ++i) {
-      r[i] = T(0.0);
-      for (int j = 0; j <= i; ++j) r[i] += whitening(i, j) * e[j];
-    }
+    whiten(whitening, e, 6, r);
     return true;
   }
 };
@@ -551,8 +552,14 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   // The chain's blocks, for the marginal covariances: states, then the calibrations with fixes.
   std::vector<double*> state_blocks(n), global_blocks;
   std::vector<std::size_t> global_rsu;  // which calibrated RSU each global block is
-  std::map<const double*, std::size_t> state_of;
-  for (std::size_t k = 0; k < n; ++k) state_blocks[k] = blockOf(k), state_of[blockOf(k)] = k;
+  for (std::size_t k = 0; k < n; ++k) state_blocks[k] = blockOf(k);
+  // The state a parameter block is, or n for another block (a calibration).
+  static_assert(sizeof(std::array<double, kState>) == kState * sizeof(double), "the states lie end to end");
+  auto stateOf = [&, begin = x.front().data()](const double* block) {
+    const std::less<const double*> before;
+    if (before(block, begin) || !before(block, begin + n * kState)) return n;
+    return static_cast<std::size_t>(block - begin) / kState;
+  };
   auto collectGlobals = [&] {
     global_blocks.clear();
     global_rsu.clear();
@@ -616,14 +623,18 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
       int m = 0;
     };
     std::map<std::string, Tally> tally;
+    std::vector<double*> parameters;
+    std::vector<double> residuals;
+    std::vector<std::vector<double>> jacobian_storage;
+    std::vector<double*> jacobians;
     for (const Added& a : added) {
+      if (a.source == &kBiasSource) continue;  // measured below, from the states
       const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(a.id);
-      std::vector<double*> parameters;
       problem.GetParameterBlocksForResidualBlock(a.id, &parameters);
       const int rows = cost->num_residuals();
-      std::vector<double> residuals(static_cast<std::size_t>(rows));
-      std::vector<std::vector<double>> jacobian_storage(parameters.size());
-      std::vector<double*> jacobians(parameters.size());
+      residuals.resize(static_cast<std::size_t>(rows));
+      jacobian_storage.resize(parameters.size());
+      jacobians.resize(parameters.size());
       for (std::size_t b = 0; b < parameters.size(); ++b) {
         jacobian_storage[b].resize(static_cast<std::size_t>(rows * cost->parameter_block_sizes()[b]));
         jacobians[b] = jacobian_storage[b].data();
@@ -631,16 +642,15 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
       cost->Evaluate(parameters.data(), residuals.data(), jacobians.data());
       double hat = 0.0;
       for (std::size_t b = 0; b < parameters.size(); ++b) {
-        const auto k = state_of.find(parameters[b]);
-        if (k == state_of.end()) continue;  // a calibration block: its share is small beside the states'
+        const std::size_t k = stateOf(parameters[b]);
+        if (k == n) continue;  // a calibration block: its share is small beside the states'
         const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, kState, Eigen::RowMajor>> J(jacobians[b], rows, kState);
-        hat += (J * m.states[k->second] * J.transpose()).trace();
+        hat += (J * m.states[k] * J.transpose()).trace();
       }
       double squares = 0.0;
       for (double r : residuals) squares += r * r;
       const double redundancy = (rows - hat / factorOf(a)) / rows;
       if (redundancy < 0.05) continue;  // a residual its states follow almost entirely says little
-      if (a.source == &kBiasSource) continue;  // measured below
       Tally& t = tally[*a.source];
       t.normalised.push_back(squares / redundancy);
       t.m = std::max(t.m, rows);

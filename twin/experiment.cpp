@@ -130,21 +130,20 @@ void runJob(Job& job) {
     so.replay = options;
     so.smoother = replay::smootherOptionsFor(job.config, job.calibrate);
     so.calibrate_rsus = job.calibrate;
-    const replay::SmoothResult s = replay::smoothLog(job.log, so);
-    r = s.filter;
+    replay::SmoothResult s = replay::smoothLog(job.log, so);
     if (job.calibrate && job.registry) {
       for (const auto& [id, c] : s.calibrations) job.calibration = c;
       const std::vector<rsu_client::RsuInfo> rsus = s.calibratedRegistry().rsus();
       if (!rsus.empty()) job.calibrated = rsus.front();
     }
     if (job.smooth) {
-      ExperimentRun run = job.run;
+      ExperimentRun run = job.run;  // before its errors are filled in
       run.variant = kSmootherVariant;
-      run.along.clear(), run.to_rsu.clear(), run.error.clear();
       fillRun(run, s.filter.ground_truth, s.errors, job.rsu_positions);
       run.replay_seconds = s.wall_seconds;
       job.smoothed = std::move(run);
     }
+    r = std::move(s.filter);
   } else {
     r = replay::replayLog(job.log, options);
   }
