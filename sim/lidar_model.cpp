@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "coloc/core/error.hpp"
+#include "coloc/sim/error_sources.hpp"
+
 namespace coloc::sim {
 
 LidarSpec vlp16() {
@@ -23,6 +26,20 @@ LidarSpec vlp32c() {
                           -1.4, 4.2, -1.4, 4.2, -4.2, 1.4, -1.4, 1.4, -1.4, 1.4, -1.4, 4.2, -4.2, 1.4, -1.4, 1.4};
   s.max_range = 200.0;
   return s;
+}
+
+LidarSpec lidarNamed(const std::string& name) {
+  if (name == "VLP-16") return vlp16();
+  if (name == "VLP-32C") return vlp32c();
+  throw Error("no LiDAR model '" + name + "' in the twin (VLP-16, VLP-32C)");
+}
+
+LidarSpec withErrors(LidarSpec spec, const ErrorSources& errors) {
+  spec.range_noise = errors.range_noise;
+  spec.range_noise_per_m = errors.range_noise_per_m;
+  spec.dropout = errors.dropout;
+  spec.dropout_at_max_range = errors.dropout_at_max_range;
+  return spec;
 }
 
 std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng) {
@@ -50,14 +67,19 @@ std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world,
   }
   std::vector<RayHit> hits;
   world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
-  std::normal_distribution<double> noise(0.0, spec.range_noise);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const bool dropouts = spec.dropout > 0.0 || spec.dropout_at_max_range > 0.0;
   std::vector<LidarPoint> points;
   points.reserve(hits.size() / 2);
   for (std::size_t i = 0; i < hits.size(); ++i) {
-    // One noise draw per ray, hit or not, so that the noise of a point does not depend on the others.
+    // The same draws per ray, hit or not, so that the noise of a point does not depend on the others.
     const double n = noise(rng);
+    const double u = dropouts ? uniform(rng) : 1.0;
     if (hits[i].distance < 0.0f) continue;
-    const double range = hits[i].distance + n;
+    const double r = hits[i].distance;
+    if (dropouts && u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
+    const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
     if (range < spec.min_range || range > spec.max_range) continue;
     points.push_back({static_cast<float>(range) * local_directions[i], times[i], laser_of[i], hits[i].mesh});
   }

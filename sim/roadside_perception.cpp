@@ -77,62 +77,203 @@ RoadsidePerception::RoadsidePerception(RoadsidePerception&&) noexcept = default;
 RoadsidePerception& RoadsidePerception::operator=(RoadsidePerception&&) noexcept = default;
 const RoadsidePerceptionConfig& RoadsidePerception::config() const { return impl_->config; }
 
+const char* toString(Refusal r) {
+  switch (r) {
+    case Refusal::kNone: return "none";
+    case Refusal::kNoVehicle: return "no vehicle at the CAM position";
+    case Refusal::kTooLarge: return "cluster larger than the vehicle";
+    case Refusal::kAmbiguous: return "more than one object at the CAM position";
+    case Refusal::kOccluded: return "vehicle partly hidden by another object";
+    case Refusal::kNotAtPosition: return "fitted vehicle away from the CAM position";
+    case Refusal::kInconsistent: return "disagrees with the vehicle's track";
+  }
+  return "?";
+}
+
+namespace {
+
+double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+// An object: clusters that together fit in the vehicle's size, in the frame of the CAM's heading
+// (u along it, v across).
+struct Object {
+  std::vector<std::size_t> points;
+  double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9;
+  bool too_large = false;
+};
+
+// The lowest part of an object's body (below the cut, at most max_points, lowest first) into `xy`, and
+// the true-size box on its L-shape fit (its centre at the alignment point's default when < 3 points).
+AlignedBox fitBody(const std::vector<std::size_t>& points, const std::vector<Eigen::Vector3d>& foreground, const RoadsidePerceptionConfig& c,
+                   const Eigen::Vector2d& lidar, double length, double width, double heading_prior, std::vector<Eigen::Vector2d>& xy,
+                   FittedRectangle* fit = nullptr) {
+  std::vector<Eigen::Vector3d> body;
+  for (std::size_t i : points)
+    if (!c.height_cut || foreground[i].z() < c.cut_height) body.push_back(foreground[i]);
+  std::sort(body.begin(), body.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.z() < b.z(); });
+  if (c.max_points > 0 && body.size() > static_cast<std::size_t>(c.max_points)) body.resize(static_cast<std::size_t>(c.max_points));
+  xy.clear();
+  for (const auto& p : body) xy.push_back(p.head<2>());
+  if (xy.size() < 3) return {Eigen::Vector2d::Constant(1e9), 0.0, Eigen::Vector2d::Constant(1e9)};
+  const FittedRectangle rectangle = fitLShape(xy, c.lshape);
+  if (fit) *fit = rectangle;
+  return alignTrueSizeBox(rectangle, xy, lidar, length, width, heading_prior);
+}
+
+Eigen::Vector2d boxCentre(const Object& o, const std::vector<Eigen::Vector3d>& foreground, const RoadsidePerceptionConfig& c,
+                          const Eigen::Vector2d& lidar, double length, double width, double heading_prior) {
+  std::vector<Eigen::Vector2d> xy;
+  return fitBody(o.points, foreground, c, lidar, length, width, heading_prior, xy).center;
+}
+
+}  // namespace
+
 VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& frame, Stamp stamp, const Eigen::Vector2d& reference,
                                             double heading_prior, double length, double width) const {
   const auto start = std::chrono::steady_clock::now();
   const RoadsidePerceptionConfig& c = impl_->config;
   VehicleDetection out;
   out.stamp = stamp;
+  const Eigen::Vector2d lidar = impl_->mount.position.head<2>();
+  const Eigen::Vector2d heading(std::cos(heading_prior), std::sin(heading_prior)), across(-heading.y(), heading.x());
+  // Where the vehicle is expected, seen from the LiDAR: the bearings its footprint spans and the range
+  // of its nearest part. Anything of another object in that sector and nearer hides part of it.
+  const double bearing0 = std::atan2(reference.y() - lidar.y(), reference.x() - lidar.x());
+  double bearing_lo = 0.0, bearing_hi = 0.0;
+  for (double su : {-0.5, 0.5})
+    for (double sv : {-0.5, 0.5}) {
+      const Eigen::Vector2d corner = reference + su * length * heading + sv * width * across;
+      const double b = wrapAngle(std::atan2(corner.y() - lidar.y(), corner.x() - lidar.x()) - bearing0);
+      bearing_lo = std::min(bearing_lo, b);
+      bearing_hi = std::max(bearing_hi, b);
+    }
+  const Eigen::Vector2d lidar_local((lidar - reference).dot(heading), (lidar - reference).dot(across));
+  const Eigen::Vector2d nearest_local(std::clamp(lidar_local.x(), -0.5 * length, 0.5 * length),
+                                      std::clamp(lidar_local.y(), -0.5 * width, 0.5 * width));
+  const double footprint_range = (lidar_local - nearest_local).norm();
+  constexpr double kOccluderClearance = 0.3;  // m nearer than the footprint: the footprint's own error and noise
+  const auto inSector = [&](const Eigen::Vector2d& xy) {
+    const double b = wrapAngle(std::atan2(xy.y() - lidar.y(), xy.x() - lidar.x()) - bearing0);
+    return b >= bearing_lo && b <= bearing_hi && (xy - lidar).norm() < footprint_range - kOccluderClearance;
+  };
   // 1. Foreground: near the expected position and away from the reference frame. Points farther from
-  //    the reference position are background without a tree query (the paper's restriction).
+  //    the reference position are background without a tree query (the paper's restriction), except
+  //    in the sector between the LiDAR and the vehicle, where they count as occluders.
   std::vector<Eigen::Vector3d> foreground;  // map frame, z = height above the road
+  int far_occluders = 0;
   std::vector<int> index(1);
   std::vector<float> distance_sq(1);
   const double background_sq = c.background_distance * c.background_distance;
   for (const Eigen::Vector3f& p : frame) {
-    const Eigen::Vector2d xy = impl_->rotation * p.head<2>().cast<double>() + impl_->mount.position.head<2>();
-    if ((xy - reference).norm() > c.search_radius) continue;
-    if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq)
-      continue;
+    const Eigen::Vector2d xy = impl_->rotation * p.head<2>().cast<double>() + lidar;
     const double height = p.z() + impl_->mount.position.z();
     if (height < 0.05) continue;  // the road itself
-    foreground.emplace_back(xy.x(), xy.y(), height);
+    const bool near = (xy - reference).norm() <= c.search_radius;
+    if (!near && !(c.attribute && inSector(xy))) continue;
+    if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq)
+      continue;
+    if (near) foreground.emplace_back(xy.x(), xy.y(), height);
+    else ++far_occluders;
   }
   out.foreground_points = foreground.size();
   const auto groups = clusters(foreground, c.cluster_distance);
-  // 2. The vehicle is every cluster that reaches into its footprint around the expected position. A
-  //    body seen from afar falls apart into pieces (bumper, cabin, side) farther apart than any linkage
-  //    distance that still separates it from its neighbours; its size, known from the CAM, joins them.
-  const double reach = 0.5 * std::hypot(length, width) + 1.0;
   std::vector<std::size_t> vehicle_points;
-  for (const auto& g : groups) {
-    bool near = false;
-    for (std::size_t i : g) near = near || (foreground[i].head<2>() - reference).norm() <= reach;
-    if (near) vehicle_points.insert(vehicle_points.end(), g.begin(), g.end());
-  }
-  const std::vector<std::size_t>* vehicle = vehicle_points.size() >= 5 ? &vehicle_points : nullptr;
-  if (vehicle) {
-    // 3. The lowest part of the body: below the cut, at most max_points, lowest first.
-    std::vector<Eigen::Vector3d> body;
-    for (std::size_t i : *vehicle)
-      if (!c.height_cut || foreground[i].z() < c.cut_height) body.push_back(foreground[i]);
-    std::sort(body.begin(), body.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.z() < b.z(); });
-    if (c.max_points > 0 && body.size() > static_cast<std::size_t>(c.max_points)) body.resize(static_cast<std::size_t>(c.max_points));
-    if (body.size() >= 3) {
-      std::vector<Eigen::Vector2d> xy;
-      for (const auto& p : body) xy.push_back(p.head<2>());
-      const FittedRectangle fit = fitLShape(xy, c.lshape);
-      // 4. The plain L-shape centre, or the true-size box on the alignment point.
-      const AlignedBox box = alignTrueSizeBox(fit, xy, impl_->mount.position.head<2>(), length, width, heading_prior);
-      out.found = true;
-      out.fit_points = body.size();
-      out.alignment_point = box.alignment_point;
-      out.position = c.align_true_size ? box.center : fit.center;
-      out.yaw = box.yaw;
+  const auto finish = [&](Refusal why) {
+    out.refusal = why;
+    out.processing_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  };
+  if (!c.attribute) {
+    // 2. The vehicle is every cluster that reaches into its footprint around the expected position. A
+    //    body seen from afar falls apart into pieces (bumper, cabin, side) farther apart than any linkage
+    //    distance that still separates it from its neighbours; its size, known from the CAM, joins them.
+    const double reach = 0.5 * std::hypot(length, width) + 1.0;
+    for (const auto& g : groups) {
+      bool near = false;
+      for (std::size_t i : g) near = near || (foreground[i].head<2>() - reference).norm() <= reach;
+      if (near) vehicle_points.insert(vehicle_points.end(), g.begin(), g.end());
     }
+  } else {
+    // 2. Objects: the clusters, largest first, each joined to an object it fits with in the vehicle's
+    //    size (a body seen from afar falls apart into bumper, side and cabin), else an object of its own.
+    const double max_u = length + c.size_margin, max_v = width + c.size_margin;
+    std::vector<std::size_t> order(groups.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return groups[a].size() > groups[b].size(); });
+    std::vector<Object> objects;
+    for (std::size_t g : order) {
+      Object piece;
+      for (std::size_t i : groups[g]) {
+        const Eigen::Vector2d d = foreground[i].head<2>() - reference;
+        const double u = d.dot(heading), v = d.dot(across);
+        piece.u0 = std::min(piece.u0, u), piece.u1 = std::max(piece.u1, u), piece.v0 = std::min(piece.v0, v), piece.v1 = std::max(piece.v1, v);
+      }
+      piece.points = groups[g];
+      piece.too_large = piece.u1 - piece.u0 > max_u || piece.v1 - piece.v0 > max_v;
+      bool joined = false;
+      for (Object& o : objects) {
+        if (piece.too_large || o.too_large) break;
+        const double u0 = std::min(o.u0, piece.u0), u1 = std::max(o.u1, piece.u1), v0 = std::min(o.v0, piece.v0), v1 = std::max(o.v1, piece.v1);
+        if (u1 - u0 > max_u || v1 - v0 > max_v) continue;
+        o.u0 = u0, o.u1 = u1, o.v0 = v0, o.v1 = v1;
+        o.points.insert(o.points.end(), piece.points.begin(), piece.points.end());
+        joined = true;
+        break;
+      }
+      if (!joined) objects.push_back(std::move(piece));
+    }
+    // 3. The candidates: objects of some size reaching into the footprint widened by the CAM's error.
+    //    One larger than the vehicle on the footprint itself may have swallowed it: no fix.
+    const double R = c.attribution_radius;
+    const auto reaches = [&](const Object& o, double widen) {
+      return o.u1 >= -0.5 * length - widen && o.u0 <= 0.5 * length + widen && o.v1 >= -0.5 * width - widen && o.v0 <= 0.5 * width + widen;
+    };
+    std::vector<const Object*> candidates;
+    for (const Object& o : objects) {
+      if (static_cast<int>(o.points.size()) < c.min_object_points || !reaches(o, R)) continue;
+      if (o.too_large && reaches(o, 0.5 * R)) return finish(Refusal::kTooLarge);
+      if (!o.too_large) candidates.push_back(&o);
+    }
+    // 4. Nothing of another object between the LiDAR and where the vehicle is expected: a partial view
+    //    puts the box on the wrong corner.
+    const auto occluding = [&](const Object* except) {
+      int n = far_occluders;
+      for (const Object& o : objects)
+        if (&o != except)
+          for (std::size_t i : o.points) n += inSector(foreground[i].head<2>()) ? 1 : 0;
+      return n;
+    };
+    if (candidates.empty()) return finish(occluding(nullptr) >= c.occlusion_points ? Refusal::kOccluded : Refusal::kNoVehicle);
+    // 5. Each candidate fitted; the vehicle is the one whose box centre is near the CAM's position, and
+    //    it must be the only one there.
+    const Object* vehicle = nullptr;
+    double best = 1e9;
+    int plausible = 0;
+    for (const Object* o : candidates) {
+      const Eigen::Vector2d centre = boxCentre(*o, foreground, c, lidar, length, width, heading_prior);
+      const double d = (centre - reference).norm();
+      plausible += d <= R ? 1 : 0;
+      if (d < best) best = d, vehicle = o;
+    }
+    if (occluding(vehicle) >= c.occlusion_points) return finish(Refusal::kOccluded);
+    if (best > R) return finish(Refusal::kNotAtPosition);
+    if (plausible > 1) return finish(Refusal::kAmbiguous);
+    vehicle_points = vehicle->points;
   }
-  out.processing_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return out;
+  if (vehicle_points.size() < 5) return finish(Refusal::kNoVehicle);
+  // 6. The lowest part of the body, the L-shape fit, the plain centre or the true-size box.
+  std::vector<Eigen::Vector2d> xy;
+  FittedRectangle fit;
+  const AlignedBox box = fitBody(vehicle_points, foreground, c, lidar, length, width, heading_prior, xy, &fit);
+  if (xy.size() < 3) return finish(Refusal::kNoVehicle);
+  const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
+  if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);
+  out.found = true;
+  out.fit_points = xy.size();
+  out.alignment_point = box.alignment_point;
+  out.position = position;
+  out.yaw = box.yaw;
+  return finish(Refusal::kNone);
 }
 
 }  // namespace coloc::sim

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <sstream>
 
 #include "coloc/core/error.hpp"
@@ -73,6 +74,7 @@ SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& 
     r.keys(n, where, {"type", "at", "yaw", "in_world", "in_map"});
     const Eigen::Vector2d p = r.vec2(r.require(n, "at", where), where + ".at");
     o.mesh = VehicleBody{}.mesh(p.x(), p.y(), n["yaw"] ? r.number(n["yaw"], where + ".yaw") : 0.0);
+    o.position = p;
   } else {
     r.fail(n["type"], where + ".type", "unknown object type '" + o.type + "' (building, wall, pole, tree, parked_car)");
   }
@@ -80,12 +82,55 @@ SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& 
   return o;
 }
 
+ErrorSources readErrors(const Reader& r, const YAML::Node& n) {
+  r.keys(n, "errors", {"preset", "survey_position_sd", "survey_yaw_sd_deg", "clock_offset_sd_ms", "clock_jitter_sd_ms", "vehicle_body",
+                       "range_noise", "range_noise_per_m", "dropout", "dropout_at_max_range"});
+  ErrorSources e;
+  if (n["preset"] && r.choice(n["preset"], "errors.preset", {"real", "ideal"}) == "ideal") e = ErrorSources::ideal();
+  if (n["survey_position_sd"]) e.survey_position_sd = r.inRange(n["survey_position_sd"], "errors.survey_position_sd", 0.0, 5.0);
+  if (n["survey_yaw_sd_deg"]) e.survey_yaw_sd = r.inRange(n["survey_yaw_sd_deg"], "errors.survey_yaw_sd_deg", 0.0, 10.0) * M_PI / 180.0;
+  if (n["clock_offset_sd_ms"]) e.clock_offset_sd = 1e-3 * r.inRange(n["clock_offset_sd_ms"], "errors.clock_offset_sd_ms", 0.0, 1000.0);
+  if (n["clock_jitter_sd_ms"]) e.clock_jitter_sd = 1e-3 * r.inRange(n["clock_jitter_sd_ms"], "errors.clock_jitter_sd_ms", 0.0, 100.0);
+  if (n["vehicle_body"]) e.detailed_vehicle = r.choice(n["vehicle_body"], "errors.vehicle_body", {"detailed", "boxes"}) == "detailed";
+  if (n["range_noise"]) e.range_noise = r.inRange(n["range_noise"], "errors.range_noise", 0.0, 1.0);
+  if (n["range_noise_per_m"]) e.range_noise_per_m = r.inRange(n["range_noise_per_m"], "errors.range_noise_per_m", 0.0, 0.1);
+  if (n["dropout"]) e.dropout = r.inRange(n["dropout"], "errors.dropout", 0.0, 0.99);
+  if (n["dropout_at_max_range"]) e.dropout_at_max_range = r.inRange(n["dropout_at_max_range"], "errors.dropout_at_max_range", 0.0, 1.0);
+  return e;
+}
+
+TrafficVehicle readTraffic(const Reader& r, const YAML::Node& n, const std::string& where) {
+  r.keys(n, where, {"lane_offset", "start", "speed", "direction", "length", "width"});
+  TrafficVehicle v;
+  if (n["lane_offset"]) v.lane_offset = r.inRange(n["lane_offset"], where + ".lane_offset", -50.0, 50.0);
+  if (n["start"]) v.start = r.number(n["start"], where + ".start");
+  if (n["speed"]) v.speed = r.inRange(n["speed"], where + ".speed", 0.0, 60.0);
+  if (n["direction"]) v.oncoming = r.choice(n["direction"], where + ".direction", {"same", "oncoming"}) == "oncoming";
+  if (n["length"]) v.body.length = r.inRange(n["length"], where + ".length", 2.5, 20.0);
+  if (n["width"]) v.body.width = r.inRange(n["width"], where + ".width", 1.4, 3.0);
+  return v;
+}
+
 }  // namespace
+
+void setErrorSources(Scenario& s, const ErrorSources& errors) {
+  s.errors = errors;
+  for (std::size_t i = 0; i < s.rsus.size(); ++i) {
+    ScenarioRsu& rsu = s.rsus[i];
+    // One stream per RSU, from the seed and its place in the list: adding an RSU changes no other's draw.
+    std::mt19937_64 rng(s.seed * 1000003ULL + 7919ULL * (i + 1));
+    std::normal_distribution<double> unit(0.0, 1.0);
+    const double dx = unit(rng), dy = unit(rng), dyaw = unit(rng), dt = unit(rng);
+    if (!rsu.survey_error_given)
+      rsu.survey_error = Eigen::Vector3d(errors.survey_position_sd * dx, errors.survey_position_sd * dy, errors.survey_yaw_sd * dyaw);
+    if (!rsu.clock_offset_given) rsu.clock_offset = errors.clock_offset_sd * dt;
+  }
+}
 
 Scenario parseScenario(const std::string& yaml_text, const std::string& source) {
   const Reader r(source);
   const YAML::Node root = r.parse(yaml_text);
-  r.keys(root, "(top level)", {"name", "seed", "ground", "objects", "route", "vehicle", "rsus"});
+  r.keys(root, "(top level)", {"name", "seed", "ground", "objects", "route", "vehicle", "rsus", "traffic", "errors"});
   Scenario s;
   s.name = root["name"] ? r.text(root["name"], "name") : "scenario";
   if (root["seed"]) s.seed = static_cast<std::uint64_t>(r.integer(root["seed"], "seed", 0, std::numeric_limits<long long>::max()));
@@ -144,15 +189,24 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
         if (e.head<2>().norm() > 10.0 || std::abs(e.z()) > 30.0)
           r.fail(n["survey_error"], where + ".survey_error", "expected [dx, dy, dyaw_deg] within 10 m and 30 deg");
         rsu.survey_error = Eigen::Vector3d(e.x(), e.y(), e.z() * M_PI / 180.0);
+        rsu.survey_error_given = true;
       }
-      if (n["clock_offset_ms"]) rsu.clock_offset = 1e-3 * r.inRange(n["clock_offset_ms"], where + ".clock_offset_ms", -1000.0, 1000.0);
+      if (n["clock_offset_ms"]) {
+        rsu.clock_offset = 1e-3 * r.inRange(n["clock_offset_ms"], where + ".clock_offset_ms", -1000.0, 1000.0);
+        rsu.clock_offset_given = true;
+      }
       if (n["lidar_model"]) rsu.lidar_model = r.text(n["lidar_model"], where + ".lidar_model");
       if (rsu.lidar_model != "VLP-16" && rsu.lidar_model != "VLP-32C")
         r.fail(n["lidar_model"], where + ".lidar_model", "unknown LiDAR model '" + rsu.lidar_model + "' (VLP-16, VLP-32C)");
       s.rsus.push_back(rsu);
     }
   }
+  if (const YAML::Node t = root["traffic"]) {
+    if (!t.IsSequence()) r.fail(t, "traffic", "expected a list of {lane_offset, start, speed, direction, length, width}");
+    for (std::size_t i = 0; i < t.size(); ++i) s.traffic.push_back(readTraffic(r, t[i], "traffic[" + std::to_string(i) + "]"));
+  }
   Route(s.route_start, s.route_heading, s.route);  // validates the pieces
+  setErrorSources(s, root["errors"] ? readErrors(r, root["errors"]) : ErrorSources{});
   return s;
 }
 

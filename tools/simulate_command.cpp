@@ -17,7 +17,7 @@ void addSimulateCommand(CLI::App& app) {
   static TwinRecordingOptions options;
   cmd->add_option("SCENARIO", scenario_path, "scenario YAML (see config/scenarios/)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir,
-                  "output folder: log/, map/, fuse.yaml, rsu_fixes.csv, rsu_fix_error.svg, rsu_perception.csv, rsu_perception.svg")
+                  "output folder: log/, map/, fuse.yaml, rsu_fixes.csv, rsu_frames.csv, rsu_fix_error.svg, rsu_perception.csv, rsu_perception.svg")
       ->capture_default_str();
   cmd->add_option("--delay", options.link.delay, "V2I delay of the fixes, s")->capture_default_str();
   cmd->add_option("--jitter", options.link.jitter, "V2I delay jitter, s")->capture_default_str();
@@ -26,8 +26,14 @@ void addSimulateCommand(CLI::App& app) {
                   "time the RSU takes from the end of its sweep to sending the fix, s (simulated, so runs repeat; "
                   "the measured time is in rsu_fixes.csv)")
       ->capture_default_str();
+  cmd->add_flag("--compare-ideal", options.ideal_comparison,
+               "also image every RSU frame in the ideal twin (no error sources) and fix it: ideal_error_m in rsu_frames.csv, beside "
+               "the real fixes in rsu_fix_error.svg");
+  static bool ideal = false;
+  cmd->add_flag("--ideal", ideal, "drive the ideal twin: the scenario without its error sources (errors: preset ideal)");
   cmd->callback([] {
-    const sim::Scenario scenario = sim::loadScenario(scenario_path);
+    sim::Scenario scenario = sim::loadScenario(scenario_path);
+    if (ideal) sim::setErrorSources(scenario, sim::ErrorSources::ideal());
     options.out_dir = out_dir;
     ProgressBar progress("simulating");
     options.progress = [&](double f) { progress.update(f); };
@@ -40,7 +46,7 @@ void addSimulateCommand(CLI::App& app) {
                 s.rays / std::max(s.ray_casting_seconds, 1e-9) * 1e-6);
     std::printf("  time: survey map %.1f s, ray casting %.1f s, roadside perception %.2f s, the rest %.1f s\n", s.map_seconds,
                 s.ray_casting_seconds, s.perception_seconds, s.wall_seconds - s.map_seconds - s.ray_casting_seconds - s.perception_seconds);
-    std::printf("  wrote %s/{log/, map/, fuse.yaml, rsu_fixes.csv, rsu_fix_error.svg, rsu_perception.csv, rsu_perception.svg}\n",
+    std::printf("  wrote %s/{log/, map/, fuse.yaml, rsu_fixes.csv, rsu_frames.csv, rsu_fix_error.svg, rsu_perception.csv, rsu_perception.svg}\n",
                 out_dir.c_str());
   });
 }

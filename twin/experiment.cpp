@@ -43,8 +43,9 @@ std::string rsuIdFor(const sim::ScenarioRsu& rsu, const std::string& lidar) { re
 
 // The site's scenario with every compared LiDAR model mounted at each of its RSUs (one virtual sensor
 // each: they do not disturb one another, so one drive serves all).
-sim::Scenario siteScenario(const std::string& site, const std::vector<std::string>& lidars) {
+sim::Scenario siteScenario(const std::string& site, const std::vector<std::string>& lidars, bool ideal) {
   sim::Scenario s = sim::parseScenario(scenarioText(site), site);
+  if (ideal) sim::setErrorSources(s, sim::ErrorSources::ideal());
   std::vector<sim::ScenarioRsu> rsus;
   for (const sim::ScenarioRsu& r : s.rsus)
     for (const std::string& lidar : lidars) {
@@ -269,13 +270,14 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       drives.push_back({s, kNextTrial, kNextMiscalibrated, 0.0, 0.0});
       drives.push_back({s, kNextTrial, kNextPerfect, 0.0, 0.0});
     }
-  // Per site and LiDAR, the registry entry the calibration drive found.
-  std::map<std::pair<std::size_t, std::string>, rsu_client::RsuInfo> calibrated_entries;
+  // Per site and LiDAR, the registry entry the calibration drive found, and the one the noise
+  // calibration drive found (commissioning), which the evaluated drives use.
+  std::map<std::pair<std::size_t, std::string>, rsu_client::RsuInfo> calibrated_entries, commissioned;
 
   std::vector<sim::Scenario> scenarios;
   std::vector<std::string> maps(config.sites.size());
   for (const std::string& site : config.sites) {
-    scenarios.push_back(siteScenario(site, config.lidars));
+    scenarios.push_back(siteScenario(site, config.lidars, config.ideal_twin));
     results.sites.push_back(siteInfo(scenarios.back()));
   }
   std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU id -> variance
@@ -319,12 +321,18 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           rsu.survey_error = Eigen::Vector3d(config.calibration_error[0], config.calibration_error[1], config.calibration_error[2] * M_PI / 180.0);
           rsu.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
         }
+      if (drive.variant == kNextPerfect)
+        for (sim::ScenarioRsu& rsu : r.scenario.rsus) {
+          rsu.survey_error.setZero();
+          rsu.clock_offset = 0.0;
+        }
     }
     const auto t0 = Clock::now();
     r.options.out_dir = results.work_dir + "/" + r.name;
     fs::remove_all(r.options.out_dir);
     r.options.map_dir = maps[drive.site];
     r.options.perception_ablation = drive.trial == 0 && drive.variant.empty();
+    r.options.ideal_comparison = drive.variant == kNoiseCalibrationDrive && !config.ideal_twin;
     r.summary = recordTwin(r.scenario, r.options);
     r.seconds = since(t0);
     return r;
@@ -390,6 +398,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           job.fix_topic = topic;
           rsu_client::RsuInfo info = registryEntry(r);
           info.calibrated_variance = variance;
+          const bool same_installation = drive.variant.empty() || drive.variant == "RSU height" || drive.variant == "speed";
+          if (const auto c = commissioned.find({drive.site, lidar}); same_installation && c != commissioned.end())
+            info.calibration = c->second.calibration;
           job.registry = rsu_client::RsuRegistry({info}, rsu_client::CovariancePlacement::kPublished);
           if (delay > 0.0 || loss > 0.0) {
             rsu_client::LinkConfig link;
@@ -428,8 +439,21 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
       }
       twist_variance[drive.site] = odometryVariance(summary.odometry, scenario.name);
+      for (const sim::ScenarioRsu& r : scenario.rsus)
+        if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end())
+          results.ideal_comparison[scenario.name + " " + r.lidar_model] = f->second;
       results.estimated_twist_variance[scenario.name] = twist_variance[drive.site];
+      if (config.calibrate_rsus)
+        for (const std::string& lidar : config.lidars) {
+          jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
+          jobs.back().calibrate = true;
+        }
     } else if (drive.variant.empty()) {
+      for (const sim::ScenarioRsu& r : scenario.rsus)
+        if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end()) {
+          auto& all = results.rsu_frames[scenario.name + " " + r.lidar_model];
+          all.insert(all.end(), f->second.begin(), f->second.end());
+        }
       jobs.push_back(makeJob("", 0.0, 0.0, "", std::nullopt));
       for (const std::string& lidar : config.lidars) {
         for (double delay : config.delays)
@@ -474,6 +498,36 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     runJobs(jobs, config.jobs);
     for (Job& j : jobs) {
       results.timing.replay += j.run.replay_seconds;
+      if (j.calibrate && drive.variant == kNoiseCalibrationDrive) {
+        for (const sim::ScenarioRsu& r : scenario.rsus) {
+          if (r.lidar_model != j.run.lidar) continue;
+          CalibrationResult c;
+          c.site = scenario.name;
+          c.lidar = j.run.lidar;
+          c.dx = r.survey_error.x(), c.dy = r.survey_error.y(), c.dyaw = r.survey_error.z(), c.clock_offset = r.clock_offset;
+          if (j.calibration) c.found = *j.calibration;
+          else c.found.note = "no fix of this RSU on the drive";
+          results.commissioning.push_back(c);
+          if (!j.calibrated || !j.calibrated->calibration) continue;
+          commissioned[{drive.site, j.run.lidar}] = *j.calibrated;
+          // The fixes' variance as the calibrated registry will pass them on.
+          const rsu_client::RsuCalibrationEntry& k = *j.calibrated->calibration;
+          const Eigen::Vector2d at = registryEntry(r).position;
+          std::vector<Eigen::Vector2d> corrected;
+          const auto e = summary.fix_errors.find(r.id);
+          const auto p = summary.fix_positions.find(r.id);
+          if (e == summary.fix_errors.end() || p == summary.fix_positions.end()) continue;
+          const std::vector<Eigen::Vector2d>& errors = e->second;
+          const std::vector<Eigen::Vector2d>& positions = p->second;
+          for (std::size_t i = 0; i < errors.size(); ++i) {
+            const Eigen::Vector2d truth = positions[i] - errors[i];
+            corrected.push_back(at - Eigen::Vector2d(k.dx, k.dy) + Eigen::Rotation2Dd(-k.dyaw) * (positions[i] - at) - truth);
+          }
+          measured_variance[drive.site][r.id] = robustFixVariance(corrected, r.id);
+          results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
+        }
+        continue;
+      }
       if (j.calibrate) {
         CalibrationResult c;
         c.site = scenario.name;

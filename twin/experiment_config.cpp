@@ -66,13 +66,15 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     else if (key == "smoother") c.smoother = r.flag(v, key);
     else if (key == "twist_covariance") c.twist_covariance_estimated = r.choice(v, key, {"estimated", "message"}) == "estimated";
     else if (key == "calibration") c.calibration = r.flag(v, key);
+    else if (key == "rsu_calibration") c.calibrate_rsus = r.choice(v, key, {"noise_drive", "none"}) == "noise_drive";
+    else if (key == "error_sources") c.ideal_twin = r.choice(v, key, {"real", "ideal"}) == "ideal";
     else if (key == "calibration_error") {
       c.calibration_error = r.numberList(v, key, -30.0, 30.0);
       if (c.calibration_error.size() != 3 || std::abs(c.calibration_error[0]) > 10.0 || std::abs(c.calibration_error[1]) > 10.0)
         r.fail(v, key, "expected [dx, dy, dyaw_deg] within 10 m and 30 deg");
     } else if (key == "calibration_clock_offset_ms") c.calibration_clock_offset_ms = r.inRange(v, key, -1000.0, 1000.0);
     else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, gate_recovery, bin_length, fuse_config, jobs, sweeps, "
-                                  "sweep_trials, rsu_heights, speeds, smoother, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance)");
+                                  "sweep_trials, rsu_heights, speeds, smoother, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance, error_sources, rsu_calibration)");
   }
   if (c.delays.front() != 0.0 || c.losses.front() != 0.0)
     throwConfigError(source_name, -1, "delays/losses", "the first delay and the first loss must be 0: the ideal network is the reference");
@@ -88,7 +90,7 @@ std::string scenarioText(const std::string& site) {
   try {
     return YamlReader::readFile(site, "scenario file");
   } catch (const Error&) {
-    throw Error(site + ": neither a built-in scenario (site_a, site_b) nor a readable scenario file");
+    throw Error(site + ": neither a built-in scenario (site_a, site_b, site_c) nor a readable scenario file");
   }
 }
 

@@ -1,6 +1,7 @@
 #include "coloc/twin/experiment_report.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -254,6 +255,99 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     writeFile(out_dir + "/calibration.csv", csv.str());
   }
 
+  // The error sources: fix error against distance, real beside ideal, on each site's noise calibration
+  // drive (the same frames imaged twice).
+  std::ostringstream sources_md;
+  if (!results.ideal_comparison.empty()) {
+    constexpr double kBin = 5.0;
+    constexpr int kBins = 6;
+    std::ostringstream csv;
+    csv << "site_lidar,distance_from_m,distance_to_m,frames,fixes_real,fixes_ideal,mean_error_real_m,mean_error_ideal_m,p95_error_real_m\n";
+    sources_md << "| site, roadside LiDAR |";
+    for (int b = 0; b < kBins; ++b) sources_md << fmt(" %.0f-", b * kBin) << fmt("%.0f m |", (b + 1) * kBin);
+    sources_md << " all |\n|---|";
+    for (int b = 0; b <= kBins; ++b) sources_md << "---|";
+    sources_md << "\n";
+    for (const auto& [key, frames] : results.ideal_comparison) {
+      sources_md << "| " << key << " |";
+      for (int b = 0; b <= kBins; ++b) {
+        std::vector<double> real, ideal;
+        std::size_t n = 0;
+        for (const RsuFrameRecord& f : frames) {
+          const bool in_bin = b == kBins || (f.distance >= b * kBin && (f.distance < (b + 1) * kBin || b == kBins - 1));
+          if (!in_bin) continue;
+          ++n;
+          if (f.found) real.push_back(f.error);
+          if (f.ideal_error >= 0.0) ideal.push_back(f.ideal_error);
+        }
+        const double mr = real.empty() ? std::nan("") : spread(real).mean, mi = ideal.empty() ? std::nan("") : spread(ideal).mean;
+        double p95 = std::nan("");
+        if (!real.empty()) {
+          std::sort(real.begin(), real.end());
+          p95 = real[static_cast<std::size_t>(0.95 * static_cast<double>(real.size() - 1))];
+        }
+        sources_md << " " << (n == 0 ? std::string("-") : fmt("%.1f", 100 * mr) + fmt(" / %.1f cm", 100 * mi)) << " |";
+        csv << key << "," << (b < kBins ? b * kBin : 0.0) << "," << (b < kBins ? (b + 1) * kBin : 1e3) << "," << n << "," << real.size() << ","
+            << ideal.size() << "," << mr << "," << mi << "," << p95 << "\n";
+      }
+      sources_md << "\n";
+    }
+    writeFile(out_dir + "/fix_error_by_distance.csv", csv.str());
+  }
+
+  // Commissioning: each RSU's survey and clock error as drawn, and as its noise calibration drive found it.
+  if (!results.commissioning.empty()) {
+    const double deg = 180.0 / M_PI;
+    sources_md << "\nEach RSU's survey and clock error as drawn from the error sources, and as the site's noise calibration drive "
+                  "found it (`coloc smooth --calibrate-rsus`); the evaluated drives use the calibration when it is determined:\n\n"
+               << "| site | roadside LiDAR | drawn (dx, dy, dyaw, clock) | found (± sd) |\n|---|---|---|---|\n";
+    for (const CalibrationResult& cr : results.commissioning) {
+      const smoother::RsuCalibration& f = cr.found;
+      char drawn[128], found[192];
+      std::snprintf(drawn, sizeof drawn, "%.3f m, %.3f m, %.3f deg, %.2f ms", cr.dx, cr.dy, cr.dyaw * deg, cr.clock_offset * 1e3);
+      if (f.observable)
+        std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %s", f.dx, f.sd_dx, f.dy, f.sd_dy, f.dyaw * deg,
+                      f.sd_dyaw * deg, f.clock_observable ? (fmt("%.1f", f.clock_offset * 1e3) + fmt(" ± %.1f ms", f.sd_clock_offset * 1e3)).c_str() : "clock held");
+      else
+        std::snprintf(found, sizeof found, "not determined (%s): not used", f.note.c_str());
+      sources_md << "| " << cr.site << " | " << cr.lidar << " | " << drawn << " | " << found << " |\n";
+    }
+  }
+
+  // Other road users: what the roadside perception sent and refused on the evaluated trials.
+  std::ostringstream attribution_md;
+  if (!results.rsu_frames.empty()) {
+    std::ostringstream csv;
+    csv << "site_lidar,frames,frames_with_neighbours,fixes_sent,gross_fixes,gross_fixes_with_neighbours,gross_per_100_frames_with_neighbours";
+    for (int r = 1; r < sim::kRefusalCount; ++r) csv << ",refused_" << r;
+    csv << "\n";
+    attribution_md << "| site, roadside LiDAR | frames in coverage | with neighbours | fixes sent | refused (reasons) | gross fixes sent "
+                      "(> 0.3 m) | per 100 frames with neighbours |\n|---|---|---|---|---|---|---|\n";
+    for (const auto& [key, frames] : results.rsu_frames) {
+      std::size_t with = 0, sent = 0, gross = 0, gross_with = 0;
+      std::array<std::size_t, sim::kRefusalCount> refused{};
+      for (const RsuFrameRecord& f : frames) {
+        with += f.neighbours ? 1 : 0;
+        if (!f.found) {
+          ++refused[static_cast<int>(f.refusal)];
+          continue;
+        }
+        ++sent;
+        if (f.error > 0.3) ++gross, gross_with += f.neighbours ? 1 : 0;
+      }
+      std::string reasons;
+      for (int r = 1; r < sim::kRefusalCount; ++r)
+        if (refused[r]) reasons += (reasons.empty() ? "" : "; ") + std::to_string(refused[r]) + " " + sim::toString(static_cast<sim::Refusal>(r));
+      const double per100 = with ? 100.0 * static_cast<double>(gross_with) / static_cast<double>(with) : 0.0;
+      attribution_md << "| " << key << " | " << frames.size() << " | " << with << " | " << sent << " | " << (reasons.empty() ? "none" : reasons) << " | "
+                     << gross << " | " << (with ? fmt("%.1f", per100) : std::string("-")) << " |\n";
+      csv << key << "," << frames.size() << "," << with << "," << sent << "," << gross << "," << gross_with << "," << per100;
+      for (int r = 1; r < sim::kRefusalCount; ++r) csv << "," << refused[r];
+      csv << "\n";
+    }
+    writeFile(out_dir + "/attribution.csv", csv.str());
+  }
+
   // Tables II and III: the network grid, per LiDAR, over sites and trials.
   std::ostringstream network_md, network_csv;
   network_csv << "lidar,delay_s,loss,error_paper_m,error_mean_m,change_pct,fixes_lost\n";
@@ -429,14 +523,24 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
           "(`coloc smooth --calibrate-rsus`, anchored by NDT), and the filter replays a second drive with the registry as surveyed, with the "
           "calibration found, and past a perfect RSU (same drive). Errors: plain mean within coverage.\n\n"
        << calibration_md.str() << "\n";
+  if (!sources_md.str().empty())
+    md << "## Error sources: fix error against distance\n\nEach site's noise calibration drive, every RSU frame imaged twice: with "
+          "the site's error sources (RSU survey and clock, a real car's shape, range-dependent noise and dropouts) and in the ideal "
+          "twin. Mean fix error, real / ideal, per 5 m of distance from the RSU (the last bin takes everything beyond).\n\n"
+       << sources_md.str() << "\n";
+  if (!attribution_md.str().empty())
+    md << "## Other road users: what the roadside perception sent\n\nEvery RSU frame within coverage on the evaluated trials; "
+          "\"with neighbours\": another vehicle the RSU's background does not have (traffic, a car parked since the survey) within 10 m "
+          "of the ego vehicle.\n\n"
+       << attribution_md.str() << "\n";
   if (c.network)
-    md << "## Tables II and III: network delay and packet loss\n\nMean over both sites and the first " << std::min(c.trials, c.network_trials)
+    md << "## Tables II and III: network delay and packet loss\n\nMean over the sites and the first " << std::min(c.trials, c.network_trials)
        << " trial(s) of each; every cell replays the same drives.\n" << network_md.str() << "\n![network](network.svg)\n\n";
   md << "## Figures\n\n";
   for (const SiteInfo& site : results.sites)
     md << "![" << site.name << "](fig4_error_along_road_" << site.name << ".svg)\n![" << site.name << " trials](fig5_trials_" << site.name
        << ".svg)\n\n";
-  if (c.sweeps) md << "## Sweeps beyond the paper (" << std::min(c.sweep_trials, c.trials) << " trial(s) per site, both sites pooled)\n\n" << sweeps_md.str() << "\n";
+  if (c.sweeps) md << "## Sweeps beyond the paper (" << std::min(c.sweep_trials, c.trials) << " trial(s) per site, the sites pooled)\n\n" << sweeps_md.str() << "\n";
   if (!results.estimated_variance.empty()) {
     md << "Measured on each site's noise calibration drive, which is not evaluated: the fixes' variance (robust, from the median "
           "absolute error per axis): ";
@@ -463,10 +567,10 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
      << "(" << c.jobs << " side by side).\n\n"
      << "## Files\n\n"
-     << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
+     << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`, `fix_error_by_distance.csv`, `attribution.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
      << "- `error_along_road.csv`: minimum error per bin along the road, per site, trial and configuration (figures 4 and 5)\n"
      << "- `recordings/SITE/trial_N/`: each drive as a rosbag2 log with its map and fuse configuration (`coloc fuse` replays it), the "
-        "RSU fixes and, for trial 0, what each perception step buys (`rsu_perception.svg`)\n";
+        "RSU fixes, every RSU frame's outcome (`rsu_frames.csv`) and, for trial 0, what each perception step buys (`rsu_perception.svg`)\n";
   writeFile(out_dir + "/README.md", md.str());
   return table1.str();
 }

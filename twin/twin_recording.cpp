@@ -17,6 +17,7 @@
 #include "coloc/ndt/tile_map.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
+#include "coloc/sim/fix_consistency.hpp"
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/sim/roadside_perception.hpp"
 #include "coloc/sim/survey_map.hpp"
@@ -41,10 +42,61 @@ Stamp at(double t) { return kEpoch + fromSeconds(t); }
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-sim::LidarSpec lidarNamed(const std::string& name) {
-  if (name == "VLP-16") return sim::vlp16();
-  if (name == "VLP-32C") return sim::vlp32c();
-  throw Error("no LiDAR model '" + name + "' in the twin (VLP-16, VLP-32C)");
+// The world as a LiDAR sees it at one instant: the static meshes, the other road users and, for the
+// roadside LiDARs, the ego vehicle. Vehicles off the road wait out of every sensor's reach.
+class MovingWorld {
+ public:
+  MovingWorld(const std::vector<sim::TriangleMesh>& statics, const sim::Scenario& scenario, bool detailed, bool with_ego)
+      : scenario_(scenario), route_(scenario.route_start, scenario.route_heading, scenario.route) {
+    for (const sim::TriangleMesh& m : statics) caster_.addMesh(m);
+    for (const sim::TrafficVehicle& v : scenario.traffic) {
+      sim::VehicleBody body = detailed ? sim::VehicleBody{} : sim::VehicleBody::boxes();
+      body.length = v.body.length;
+      body.width = v.body.width;
+      traffic_bodies_.push_back(body);
+      traffic_.push_back(caster_.addMesh(body.mesh(away(traffic_.size()), 1e4, 0.0)));
+    }
+    ego_body_ = detailed ? sim::VehicleBody{} : sim::VehicleBody::boxes();
+    if (with_ego) ego_ = caster_.addMesh(ego_body_.mesh(1e4, 1e4, 0.0));
+    caster_.commit();
+  }
+  /// Moves the traffic (and the ego vehicle, if there is one) to time t.
+  void place(double t, const sim::VehicleState* ego) {
+    for (std::size_t i = 0; i < traffic_.size(); ++i) {
+      const auto pose = sim::trafficPose(route_, scenario_.traffic[i], t);
+      caster_.updateMesh(traffic_[i], pose ? traffic_bodies_[i].mesh(pose->x(), pose->y(), pose->z()) : traffic_bodies_[i].mesh(away(i), 1e4, 0.0));
+    }
+    if (ego && ego_ >= 0) caster_.updateMesh(ego_, ego_body_.mesh(ego->position.x(), ego->position.y(), ego->yaw));
+    if (!traffic_.empty() || (ego && ego_ >= 0)) caster_.commit();
+  }
+  const sim::RayCaster& caster() const { return caster_; }
+  const sim::VehicleBody& egoBody() const { return ego_body_; }
+
+ private:
+  static double away(std::size_t i) { return 1e4 + 20.0 * static_cast<double>(i + 1); }
+  const sim::Scenario& scenario_;
+  sim::Route route_;
+  sim::RayCaster caster_;
+  std::vector<int> traffic_;
+  std::vector<sim::VehicleBody> traffic_bodies_;
+  sim::VehicleBody ego_body_;
+  int ego_ = -1;
+};
+
+// Whether another road user the RSU's background does not have (traffic, a car parked since the
+// survey) is within `radius` of the ego vehicle at time t.
+bool neighboursNear(const sim::Scenario& scenario, const sim::Route& route, const Eigen::Vector2d& ego, double t, double radius) {
+  for (const sim::TrafficVehicle& v : scenario.traffic)
+    if (const auto pose = sim::trafficPose(route, v, t); pose && (pose->head<2>() - ego).norm() <= radius) return true;
+  for (const sim::SceneObject& o : scenario.objects)
+    if (o.type == "parked_car" && o.in_world && !o.in_map && (o.position - ego).norm() <= radius) return true;
+  return false;
+}
+
+std::vector<Eigen::Vector3f> frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, std::mt19937_64& rng) {
+  std::vector<Eigen::Vector3f> frame;
+  for (const auto& p : sim::scanSweep(spec, world, [&](double) { return pose; }, rng)) frame.push_back(p.position);
+  return frame;
 }
 
 std::uint64_t raysPerSweep(const sim::LidarSpec& spec) {
@@ -149,18 +201,23 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     summary.map_seconds = since(t0);
   }
 
-  // 2. The world: static scene, plus the ego vehicle for the roadside LiDARs.
-  sim::RayCaster scene, with_vehicle;
-  for (const sim::TriangleMesh& m : scenario.worldMeshes()) {
-    scene.addMesh(m);
-    with_vehicle.addMesh(m);
-  }
-  const sim::VehicleBody body;
-  const int body_mesh = with_vehicle.addMesh(body.mesh(1e4, 1e4, 0.0));
-  scene.commit();
-  with_vehicle.commit();
-  const sim::Drive drive(sim::Route(scenario.route_start, scenario.route_heading, scenario.route), scenario.speed);
+  // 2. The world: static scene and traffic for the vehicle's LiDAR, plus the ego vehicle for the
+  //    roadside LiDARs; the ideal twin's world beside it if asked. The RSUs' background frames are of
+  //    the world as surveyed: what was parked since is foreground to them.
+  const sim::ErrorSources& errors = scenario.errors;
+  const std::vector<sim::TriangleMesh> world_meshes = scenario.worldMeshes();
+  MovingWorld scene(world_meshes, scenario, errors.detailed_vehicle, false), with_vehicle(world_meshes, scenario, errors.detailed_vehicle, true);
+  std::unique_ptr<MovingWorld> ideal_world;
+  if (options.ideal_comparison) ideal_world = std::make_unique<MovingWorld>(world_meshes, scenario, false, true);
+  sim::RayCaster surveyed;
+  for (const sim::TriangleMesh& m : scenario.mapMeshes()) surveyed.addMesh(m);
+  surveyed.commit();
+  const sim::VehicleBody& body = with_vehicle.egoBody();
+  const sim::Route route(scenario.route_start, scenario.route_heading, scenario.route);
+  const sim::Drive drive(route, scenario.speed);
   std::mt19937_64 rng(scenario.seed);
+  std::mt19937_64 ideal_rng(scenario.seed + 17), stamp_rng(scenario.seed + 29);  // own streams: the main one unchanged by them
+  std::normal_distribution<double> stamp_jitter(0.0, 1.0);
 
   // 3. Roadside units: their background frames and perception.
   struct Rsu {
@@ -170,6 +227,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     rsu_client::LinkEmulator link;
     double variance;
     double range;
+    sim::LidarSpec ideal_lidar;
+    std::unique_ptr<sim::RoadsidePerception> ideal_perception;
+    sim::FixConsistency consistency, ideal_consistency;
   };
   std::vector<Rsu> rsus;
   for (const sim::ScenarioRsu& r : scenario.rsus) {
@@ -177,8 +237,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     mount.position = {r.position.x(), r.position.y(), r.height};
     mount.yaw = r.yaw;
     const Eigen::Isometry3d pose = Eigen::Translation3d(mount.position) * Eigen::AngleAxisd(r.yaw, Eigen::Vector3d::UnitZ());
-    std::vector<Eigen::Vector3f> reference;
-    for (const auto& p : sim::scanSweep(lidarNamed(r.lidar_model), scene, [&](double) { return pose; }, rng)) reference.push_back(p.position);
+    const sim::LidarSpec lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), errors);
+    const std::vector<Eigen::Vector3f> reference = frameOf(lidar, surveyed, pose, rng);
     const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
     rsu_client::LinkConfig l = options.link;
     l.seed = scenario.seed + rsus.size() + 1;
@@ -189,7 +249,12 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       c.height_cut = kVariants[v].height_cut;
       perception.emplace_back(reference, mount, c);
     }
-    rsus.push_back({r, lidarNamed(r.lidar_model), std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range});
+    Rsu rsu{r, lidar, std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range, {}, nullptr, {}, {}};
+    if (ideal_world) {
+      rsu.ideal_lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), sim::ErrorSources::ideal());
+      rsu.ideal_perception = std::make_unique<sim::RoadsidePerception>(frameOf(rsu.ideal_lidar, surveyed, pose, ideal_rng), mount);
+    }
+    rsus.push_back(std::move(rsu));
   }
 
   // 4. The drive, recorded.
@@ -200,6 +265,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::fixTopic(r.info.id), "geometry_msgs/msg/PoseWithCovarianceStamped"));
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
+  std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
+  frames_csv << "stamp_s,rsu,lidar,distance_m,neighbours,outcome,error_m,ideal_error_m,fit_points\n";
   std::ofstream ablation_csv;
   if (options.perception_ablation) {
     ablation_csv.open(out_dir + "/rsu_perception.csv");
@@ -207,7 +274,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   }
   std::map<std::string, PlotSeries> fix_errors;  // per RSU: error against distance
   std::map<std::pair<std::string, std::size_t>, std::pair<std::vector<double>, std::vector<double>>> variant_errors;
-  const sim::LidarSpec roof = lidarNamed(scenario.vehicle_lidar);
+  const sim::LidarSpec roof = sim::withErrors(sim::lidarNamed(scenario.vehicle_lidar), errors);
   const sim::OdometryNoise& odometry_noise = scenario.odometry;
   const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
   for (int k = 0; k <= ticks; ++k) {  // 100 Hz
@@ -236,27 +303,30 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       bag.write("/vehicle/twist", at(t) + 2'000'000, b.data(), b.size());
     }
     if (k % 10 != 0) continue;
-    // 10 Hz: a roof sweep, and each RSU's frame.
+    // 10 Hz: a roof sweep, and each RSU's frame; the traffic where it is half-way through them.
+    const double capture = t + 0.05;
+    const sim::VehicleState seen = drive.at(capture);
+    scene.place(capture, nullptr);
     const auto c0 = Clock::now();
-    const auto sweep = sim::scanSweep(roof, scene, [&](double dt) { return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height); }, rng);
+    const auto sweep = sim::scanSweep(roof, scene.caster(), [&](double dt) { return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height); }, rng);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
     const io::Bytes b = io::encodePointCloud2(toPointCloud2(sweep, at(t)));
     bag.write("/points", at(t + 0.1) + 5'000'000, b.data(), b.size());  // the sweep ends, the driver publishes
     ++summary.scans;
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
-    const double capture = t + 0.05;
-    const sim::VehicleState seen = drive.at(capture);
-    with_vehicle.updateMesh(body_mesh, body.mesh(seen.position.x(), seen.position.y(), seen.yaw));
-    with_vehicle.commit();
+    with_vehicle.place(capture, &seen);
+    if (ideal_world) ideal_world->place(capture, &seen);
+    bool any_in_range = false;
+    for (const Rsu& r : rsus) any_in_range = any_in_range || (seen.position - r.info.position).norm() <= r.range;
+    const bool neighbours = any_in_range && neighboursNear(scenario, route, seen.position, capture, 10.0);
     for (Rsu& r : rsus) {
       const double distance = (seen.position - r.info.position).norm();
       if (distance > r.range) continue;
       const Eigen::Isometry3d pose = Eigen::Translation3d(r.info.position.x(), r.info.position.y(), r.info.height) *
                                      Eigen::AngleAxisd(r.info.yaw, Eigen::Vector3d::UnitZ());
       const auto c1 = Clock::now();
-      std::vector<Eigen::Vector3f> frame;
-      for (const auto& p : sim::scanSweep(r.lidar, with_vehicle, [&](double) { return pose; }, rng)) frame.push_back(p.position);
+      const std::vector<Eigen::Vector3f> frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);
       summary.ray_casting_seconds += since(c1);
       summary.rays += raysPerSweep(r.lidar);
       // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
@@ -278,7 +348,36 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
           series.second.push_back(e);
         }
       }
-      if (!d.found) continue;
+      // The CAM's velocity carries the previous frame's fix to this one.
+      const Eigen::Vector2d velocity = seen.speed * Eigen::Vector2d(std::cos(seen.yaw), std::sin(seen.yaw));
+      const auto confirm = [&](sim::VehicleDetection& det, sim::FixConsistency& consistency) {
+        if (!det.found) return consistency.miss();
+        if (!consistency.agrees(det.stamp, det.position, velocity)) det.found = false, det.refusal = sim::Refusal::kInconsistent;
+      };
+      confirm(d, r.consistency);
+      RsuFrameRecord record;
+      record.distance = distance;
+      record.neighbours = neighbours;
+      record.found = d.found;
+      record.refusal = d.refusal;
+      record.fit_points = d.fit_points;
+      if (r.ideal_perception) {
+        const std::vector<Eigen::Vector3f> ideal_frame = frameOf(r.ideal_lidar, ideal_world->caster(), pose, ideal_rng);
+        sim::VehicleDetection di = r.ideal_perception->detect(ideal_frame, at(capture), reference, seen.yaw, ideal_world->egoBody().length,
+                                                                    ideal_world->egoBody().width);
+        confirm(di, r.ideal_consistency);
+        if (di.found) record.ideal_error = (di.position - seen.position).norm();
+      }
+      const auto keep = [&](const RsuFrameRecord& f) {
+        summary.rsu_frames[r.info.id].push_back(f);
+        frames_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << f.distance << "," << (f.neighbours ? 1 : 0)
+                   << "," << (f.found ? "fix" : sim::toString(f.refusal)) << "," << (f.found ? f.error : std::nan("")) << ","
+                   << (f.ideal_error >= 0.0 ? f.ideal_error : std::nan("")) << "," << f.fit_points << "\n";
+      };
+      if (!d.found) {
+        keep(record);
+        continue;
+      }
       const Stamp ready = at(capture + 0.05 + options.rsu_processing);  // end of the sweep + processing
       const std::optional<Stamp> delivered = r.link.transmit(ready);
       // The RSU reports in the map frame through its surveyed pose, and stamps on its own clock.
@@ -287,6 +386,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       d.position = r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * local;
       const Eigen::Vector2d error = d.position - seen.position;
       summary.fix_errors[r.info.id].push_back(error);
+      summary.fix_positions[r.info.id].push_back(d.position);
+      record.error = error.norm();
+      keep(record);
       fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","
                 << error.y() << "," << error.norm() << "," << d.processing_ms << "," << (delivered ? 1 : 0) << "\n";
       PlotSeries& series = fix_errors[r.info.id];
@@ -299,7 +401,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         continue;
       }
       io::StampedPose fix;
-      fix.header = {at(capture) + fromSeconds(r.info.clock_offset), "map"};
+      // Stamped on the RSU's clock, with its per-frame stamp error.
+      const double jitter = errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0;
+      fix.header = {at(capture) + fromSeconds(r.info.clock_offset + jitter), "map"};
       fix.measurement.pose.position = {d.position.x(), d.position.y(), 0.0};
       fix.measurement.covariance = Matrix6d::Zero();
       fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;
@@ -317,6 +421,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     plot.y_label = "fix error [m]";
     plot.y_from_zero = true;
     for (auto& [id, series] : fix_errors) plot.series.push_back(series);
+    if (options.ideal_comparison)
+      for (const auto& [id, frames] : summary.rsu_frames) {
+        std::vector<double> x, y;
+        for (const RsuFrameRecord& f : frames)
+          if (f.ideal_error >= 0.0) x.push_back(f.distance), y.push_back(f.ideal_error);
+        if (!x.empty()) plot.series.push_back(binnedMean(id + ", ideal twin (mean per 2 m)", x, y, 2.0));
+      }
     writeSvg(out_dir + "/rsu_fix_error.svg", plot);
   }
   if (!variant_errors.empty()) {

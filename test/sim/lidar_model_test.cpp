@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "coloc/sim/lidar_model.hpp"
 
@@ -93,6 +94,48 @@ TEST(LidarModel, MovingSensorScanCarriesMotionDistortion) {
   }
   EXPECT_NEAR(first, 29.5, 0.05);
   EXPECT_NEAR(last, 27.5, 0.05);
+}
+
+// Inside a tall ring of radius R around the sensor, every ray returns at about R; how the noise and
+// the lost returns grow with range.
+struct RingScan {
+  double noise_sd = 0.0, lost = 0.0;
+};
+RingScan ringScan(const LidarSpec& spec, float radius) {
+  RayCaster world;
+  world.addMesh(cylinder({0, 0, -40}, radius, 80, 720));
+  world.commit();
+  const auto still = [](double) { return Eigen::Isometry3d::Identity(); };
+  LidarSpec exact = spec;
+  exact.range_noise = exact.range_noise_per_m = exact.dropout = exact.dropout_at_max_range = 0.0;
+  std::mt19937_64 a(1), b(2);
+  const auto truth = scanSweep(exact, world, still, a), noisy = scanSweep(spec, world, still, b);
+  std::map<std::pair<int, float>, float> range;
+  for (const LidarPoint& p : truth) range[{p.laser, p.time}] = p.position.norm();
+  double sum_sq = 0.0;
+  for (const LidarPoint& p : noisy) {
+    const double e = p.position.norm() - range.at({p.laser, p.time});
+    sum_sq += e * e;
+  }
+  return {std::sqrt(sum_sq / noisy.size()), 1.0 - static_cast<double>(noisy.size()) / truth.size()};
+}
+
+TEST(LidarModel, RangeNoiseAndLostReturnsGrowWithRangeAsConfigured) {
+  LidarSpec spec = vlp16();  // 100 m datasheet range
+  spec.range_noise = 0.02;
+  spec.range_noise_per_m = 0.0002;
+  spec.dropout = 0.01;
+  spec.dropout_at_max_range = 0.5;
+  for (float r : {10.0f, 80.0f}) {
+    const RingScan s = ringScan(spec, r);
+    EXPECT_NEAR(s.noise_sd, 0.02 + 0.0002 * r, 0.05 * (0.02 + 0.0002 * r)) << "at " << r << " m";  // 28,800 rays: 1 % sampling error
+    const double expected = 0.01 + 0.5 * (r / 100.0) * (r / 100.0);
+    EXPECT_NEAR(s.lost, expected, 0.01) << "at " << r << " m";
+  }
+  // The ideal spec loses nothing and its noise does not grow.
+  const LidarSpec ideal = vlp16();
+  EXPECT_EQ(ringScan(ideal, 80.0f).lost, 0.0);
+  EXPECT_NEAR(ringScan(ideal, 80.0f).noise_sd, 0.02, 0.001);
 }
 
 }  // namespace

@@ -22,7 +22,7 @@ std::map<std::pair<bool, bool>, double> meanErrors(const LidarSpec& spec, const 
   RayCaster world;
   world.addMesh(groundRectangle({-120, -30}, {120, 30}));
   world.addMesh(box({0, 16, 0}, {200, 1, 8}));  // a facade across the road
-  const VehicleBody car;
+  const VehicleBody car = VehicleBody::boxes();  // the paper's question, on the ideal twin's car
   const int car_mesh = world.addMesh(car.mesh(500, 500, 0));  // parked out of sight for the reference frame
   world.commit();
   RsuMount mount;
@@ -80,7 +80,67 @@ TEST(RoadsidePerception, NoVehicleInViewIsNotFound) {
   for (const LidarPoint& p : scanSweep(vlp16(), world, [](double) { return Eigen::Isometry3d(Eigen::Translation3d(0, 0, 2)); }, rng))
     frame.push_back(p.position);
   const RoadsidePerception perception(frame, RsuMount{});
-  EXPECT_FALSE(perception.detect(frame, 0, {10, 0}, 0.0, 4.5, 1.8).found);
+  const VehicleDetection d = perception.detect(frame, 0, {10, 0}, 0.0, 4.5, 1.8);
+  EXPECT_FALSE(d.found);
+  EXPECT_EQ(d.refusal, Refusal::kNoVehicle);
+}
+
+// A street with an RSU 6 m from the ego lane, the ego vehicle at x on it and other cars around; the
+// frame's detection with the CAM's position 0.3 m off.
+class Neighbours : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    world_.addMesh(groundRectangle({-80, -30}, {80, 30}));
+    world_.addMesh(box({0, 16, 0}, {160, 1, 8}));
+    for (int i = 0; i < 3; ++i) cars_.push_back(world_.addMesh(car_.mesh(1e4 + 10 * i, 1e4, 0)));
+    world_.commit();
+    mount_.position = {0.0, -6.0, 2.0};
+
+    reference_ = frame();
+  }
+  std::vector<Eigen::Vector3f> frame() {
+    std::mt19937_64 rng(11);
+    std::vector<Eigen::Vector3f> f;
+    for (const LidarPoint& p : scanSweep(vlp32c(), world_, [&](double) { return Eigen::Isometry3d(Eigen::Translation3d(mount_.position)); }, rng))
+      f.push_back(p.position);
+    return f;
+  }
+  // Places the cars (x, y, yaw) (the first is the ego vehicle) and detects the ego.
+  VehicleDetection detect(const std::vector<Eigen::Vector3d>& cars) {
+    for (std::size_t i = 0; i < cars_.size(); ++i)
+      world_.updateMesh(cars_[i], i < cars.size() ? car_.mesh(cars[i].x(), cars[i].y(), cars[i].z()) : car_.mesh(1e4 + 10 * i, 1e4, 0));
+    world_.commit();
+    const RoadsidePerception perception(reference_, mount_);
+    return perception.detect(frame(), 0, cars[0].head<2>() + Eigen::Vector2d(0.2, -0.22), cars[0].z(), car_.length, car_.width);
+  }
+  RayCaster world_;
+  VehicleBody car_;
+  std::vector<int> cars_;
+  RsuMount mount_;
+  std::vector<Eigen::Vector3f> reference_;
+};
+
+TEST_F(Neighbours, CarsInTheNextLaneAndOncomingAreNotTakenForTheVehicle) {
+  for (double x : {-14.0, -7.0, 0.0, 7.0, 14.0})
+    for (double dx : {-3.0, 0.0, 3.0}) {
+      const VehicleDetection d = detect({{x, 0, 0}, {x + dx, 3.5, 0}, {x - dx, 7.0, M_PI}});
+      ASSERT_TRUE(d.found) << "ego at " << x << ", neighbour " << dx << " ahead: " << toString(d.refusal);
+      EXPECT_LT((d.position - Eigen::Vector2d(x, 0)).norm(), 0.15) << "ego at " << x << ", neighbour " << dx << " ahead";
+    }
+}
+
+TEST_F(Neighbours, ACarBetweenTheRsuAndTheVehicleRefusesTheFrameAsOccluded) {
+  for (double x : {-5.0, 0.0, 5.0}) {
+    const VehicleDetection d = detect({{x, 0, 0}, {x + 0.5, -3.4, 0}});
+    EXPECT_FALSE(d.found) << "ego at " << x;
+    EXPECT_EQ(d.refusal, Refusal::kOccluded) << "ego at " << x << ": " << toString(d.refusal);
+  }
+}
+
+TEST_F(Neighbours, ACarBumperToBumperMergesWithTheVehicleAndTheFrameIsRefusedAsTooLarge) {
+  const VehicleDetection d = detect({{0, 0, 0}, {-car_.length - 0.3, 0, 0}});
+  EXPECT_FALSE(d.found);
+  EXPECT_EQ(d.refusal, Refusal::kTooLarge) << toString(d.refusal);
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include "coloc/core/error.hpp"
+#include <cmath>
+
 #include "coloc/sim/scene.hpp"
 #include "coloc/sim/survey_map.hpp"
 
@@ -48,6 +50,55 @@ TEST(Scenario, RsusCarryTheirSurveyErrorAndClockOffsetInTheScenariosUnits) {
   expectError(std::string(kRoute) + "rsus:\n  - {id: a, position: [10, 5], survey_error: [0.1, 0.1]}\n",
               "rsus[0].survey_error: expected [dx, dy, dyaw_deg]");
   expectError(std::string(kRoute) + "odometry: {}\nrsus: []\n", "odometry: unknown key");
+}
+
+TEST(Scenario, UnstatedRsuSurveyAndClockErrorsAreDrawnOncePerInstallationFromTheErrorSources) {
+  const std::string rsus = "rsus:\n  - {id: a, position: [10, 5]}\n  - {id: b, position: [40, 5], survey_error: [0.1, 0, 0], clock_offset_ms: 3}\n";
+  const Scenario s = parseScenario(std::string(kRoute) + "seed: 4\n" + rsus, "s.yaml");
+  // Drawn for a, as stated for b; the same draw on every parse (one installation, one survey).
+  EXPECT_GT(s.rsus[0].survey_error.head<2>().norm(), 0.0);
+  EXPECT_LT(s.rsus[0].survey_error.head<2>().norm(), 5 * s.errors.survey_position_sd);
+  EXPECT_LT(std::abs(s.rsus[0].survey_error.z()), 5 * s.errors.survey_yaw_sd);
+  EXPECT_LT(std::abs(s.rsus[0].clock_offset), 5 * s.errors.clock_offset_sd);
+  EXPECT_EQ(parseScenario(std::string(kRoute) + "seed: 4\n" + rsus, "s.yaml").rsus[0].survey_error, s.rsus[0].survey_error);
+  EXPECT_NE(parseScenario(std::string(kRoute) + "seed: 5\n" + rsus, "s.yaml").rsus[0].survey_error, s.rsus[0].survey_error);
+  EXPECT_EQ(s.rsus[1].survey_error, Eigen::Vector3d(0.1, 0, 0));
+  EXPECT_DOUBLE_EQ(s.rsus[1].clock_offset, 0.003);
+  // The ideal twin: nothing drawn, what is stated kept.
+  Scenario ideal = s;
+  setErrorSources(ideal, ErrorSources::ideal());
+  EXPECT_EQ(ideal.rsus[0].survey_error, Eigen::Vector3d::Zero());
+  EXPECT_EQ(ideal.rsus[0].clock_offset, 0.0);
+  EXPECT_EQ(ideal.rsus[1].survey_error, Eigen::Vector3d(0.1, 0, 0));
+  EXPECT_FALSE(ideal.errors.detailed_vehicle);
+  // The errors section, in the file's units, and its mistakes.
+  const Scenario e = parseScenario(std::string(kRoute) + "errors: {preset: ideal, survey_yaw_sd_deg: 0.5, clock_offset_sd_ms: 10, dropout: 0.1}\n", "s.yaml");
+  EXPECT_NEAR(e.errors.survey_yaw_sd, 0.5 * M_PI / 180.0, 1e-15);
+  EXPECT_DOUBLE_EQ(e.errors.clock_offset_sd, 0.010);
+  EXPECT_DOUBLE_EQ(e.errors.dropout, 0.1);
+  EXPECT_EQ(e.errors.survey_position_sd, 0.0);
+  expectError(std::string(kRoute) + "errors: {fog: 1}\n", "errors.fog: unknown key");
+  expectError(std::string(kRoute) + "errors: {dropout: 1.5}\n", "errors.dropout");
+  expectError(std::string(kRoute) + "errors: {vehicle_body: blob}\n", "errors.vehicle_body: expected one of detailed, boxes");
+}
+
+TEST(Traffic, VehiclesFollowTheRouteInTheirLaneAndLeaveItAtItsEnds) {
+  const Scenario s = parseScenario(std::string(kRoute) +
+                                       "traffic:\n  - {lane_offset: 3.5, start: 10, speed: 5}\n  - {lane_offset: 7, start: 40, speed: 10, direction: oncoming}\n",
+                                   "s.yaml");
+  ASSERT_EQ(s.traffic.size(), 2u);
+  const Route route(s.route_start, s.route_heading, s.route);
+  const auto same = trafficPose(route, s.traffic[0], 2.0), oncoming = trafficPose(route, s.traffic[1], 2.0);
+  ASSERT_TRUE(same && oncoming);
+  EXPECT_NEAR(same->x(), 20.0, 1e-9);
+  EXPECT_NEAR(same->y(), 3.5, 1e-9);  // to the left of the route
+  EXPECT_NEAR(same->z(), 0.0, 1e-9);
+  EXPECT_NEAR(oncoming->x(), 20.0, 1e-9);
+  EXPECT_NEAR(std::abs(oncoming->z()), M_PI, 1e-9);  // facing the other way
+  EXPECT_FALSE(trafficPose(route, s.traffic[0], 9.0));  // past the route's 50 m
+  EXPECT_FALSE(trafficPose(route, s.traffic[1], 4.5));
+  expectError(std::string(kRoute) + "traffic:\n  - {direction: sideways}\n", "traffic[0].direction: expected one of same, oncoming");
+  expectError(std::string(kRoute) + "traffic: {speed: 3}\n", "traffic: expected a list");
 }
 
 TEST(SurveyMap, SamplesTheSurveyedSurfacesWithinNoise) {

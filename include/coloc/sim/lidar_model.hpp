@@ -1,6 +1,7 @@
 #pragma once
 // Velodyne LiDARs as the twist simulates them: real vertical angle tables, 10 Hz rotation with 0.2 deg
-// azimuth steps, each point stamped with its time in the sweep, Gaussian range noise, range limits.
+// azimuth steps, each point stamped with its time in the sweep, Gaussian range noise growing with range,
+// lost returns, range limits.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
@@ -18,7 +19,10 @@ struct LidarSpec {
   std::vector<double> azimuth_offset_deg; ///< per laser (rot_correction)
   double rotation_hz = 10.0;
   double azimuth_step_deg = 0.2;
-  double range_noise = 0.02;  ///< m, standard deviation
+  double range_noise = 0.02;        ///< m, standard deviation at zero range
+  double range_noise_per_m = 0.0;   ///< m of standard deviation per m of range
+  double dropout = 0.0;             ///< share of returns lost at any range
+  double dropout_at_max_range = 0.0;  ///< further share lost at max_range, growing with (range / max_range)^2
   double min_range = 0.9;     ///< m
   double max_range = 100.0;   ///< m
 };
@@ -26,6 +30,11 @@ struct LidarSpec {
 /// Velodyne's published calibration (ros-drivers/velodyne VLP16db.yaml, VeloView-VLP-32C.yaml).
 LidarSpec vlp16();
 LidarSpec vlp32c();
+/// "VLP-16" or "VLP-32C"; throws coloc::Error for any other name.
+LidarSpec lidarNamed(const std::string& name);
+/// The spec with the noise and dropouts of `errors` (the error-sources header), the ideal ones kept otherwise.
+struct ErrorSources;
+LidarSpec withErrors(LidarSpec spec, const ErrorSources& errors);
 
 struct LidarPoint {
   Eigen::Vector3f position;  ///< sensor frame at the time of its firing

@@ -3,6 +3,10 @@
 // against a reference frame with a k-d tree, only near the vehicle's reference position; clustering;
 // the points below 0.8 m, at most the 500 lowest; L-shape fit; the true-size box on the alignment
 // point; the result in the map frame, stamped with the frame's capture time.
+// Other road users share the road: the clusters are grouped into objects no larger than the vehicle
+// the CAM describes, and a frame is refused, with its reason, when it cannot be attributed to the ego
+// vehicle beyond doubt (nothing at the CAM's position, a cluster larger than the vehicle, two objects
+// there, something between the RSU and the vehicle). A refused fix beats a wrong one.
 #include <Eigen/Core>
 #include <memory>
 #include <vector>
@@ -20,6 +24,18 @@ struct RoadsidePerceptionConfig {
   double cut_height = 0.8;            ///< m above the road
   int max_points = 500;               ///< the lowest this many go to the fit
   bool align_true_size = true;        ///< false: report the fitted rectangle's centre (the plain L-shape)
+  /// Attribution. An object may exceed the CAM's length and width by `size_margin` (heading error,
+  /// noise); its fitted centre must lie within `attribution_radius` of the CAM's position (which is
+  /// about 0.3 m off: 3 sigma and the fit's own error), and no other object of at least
+  /// `min_object_points` may reach that far. `attribute = false`: every cluster reaching into the
+  /// vehicle's footprint is the vehicle, the refusals are off (the paper's pipeline on an empty road).
+  bool attribute = true;
+  double size_margin = 0.6;         ///< m
+  double attribution_radius = 1.2;  ///< m
+  int min_object_points = 5;
+  /// Points of other objects that hide part of the vehicle's expected footprint from the LiDAR (nearer
+  /// to it, within the footprint's bearing) make the view partial: refused from this many.
+  int occlusion_points = 5;
   LShapeConfig lshape;
 };
 
@@ -29,8 +45,22 @@ struct RsuMount {
   double yaw = 0.0;
 };
 
+/// Why a frame gave no fix.
+enum class Refusal {
+  kNone,
+  kNoVehicle,      ///< no object (or too few points) at the CAM's position
+  kTooLarge,       ///< the cluster there is larger than the vehicle: merged with a neighbour or a structure
+  kAmbiguous,      ///< more than one object there
+  kOccluded,       ///< another object between the LiDAR and the vehicle
+  kNotAtPosition,  ///< the fitted vehicle is farther from the CAM's position than attribution_radius
+  kInconsistent,   ///< disagrees with the vehicle's track (FixConsistency), or has none to agree with
+};
+const char* toString(Refusal r);
+inline constexpr int kRefusalCount = 7;
+
 struct VehicleDetection {
   bool found = false;
+  Refusal refusal = Refusal::kNone;  ///< why not, when !found
   Stamp stamp = 0;                 ///< the frame's capture time
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< vehicle centre, map frame
   double yaw = 0.0;                ///< map frame

@@ -1,12 +1,14 @@
 #pragma once
 // A digital-twin scenario from YAML: the world's objects as meshes (ground, buildings, walls, poles,
 // trees, parked cars), which of them the survey map has (a map can be older than the world), the ego
-// vehicle's route and speed, and the roadside units.
+// vehicle's route and speed, other traffic, the roadside units, and the error sources of the road.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "coloc/sim/error_sources.hpp"
 #include "coloc/sim/mesh.hpp"
+#include "coloc/sim/traffic.hpp"
 #include "coloc/sim/vehicle_motion.hpp"
 
 namespace coloc::sim {
@@ -14,6 +16,7 @@ namespace coloc::sim {
 struct SceneObject {
   std::string type;       ///< building, wall, pole, tree, parked_car
   TriangleMesh mesh;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< centre in plan (a parked car's, for ground truth)
   bool in_world = true;   ///< false: removed since the survey (the map still has it)
   bool in_map = true;     ///< false: added since the survey (the map lacks it)
 };
@@ -28,6 +31,8 @@ struct ScenarioRsu {
   /// its surveyed pose, so they are off by it; the vehicle's registry lists the surveyed position.
   Eigen::Vector3d survey_error = Eigen::Vector3d::Zero();
   double clock_offset = 0.0;  ///< s, the RSU's clock minus the vehicle's: its fixes are stamped on it
+  /// Whether the scenario states them; if not, they are drawn from the scenario's error sources.
+  bool survey_error_given = false, clock_offset_given = false;
 };
 
 struct Scenario {
@@ -43,11 +48,17 @@ struct Scenario {
   double vehicle_lidar_height = 1.9;  ///< m above the road
   OdometryNoise odometry;             ///< the wheel odometry's noise, scale error and yaw-rate bias
   std::vector<ScenarioRsu> rsus;
+  std::vector<TrafficVehicle> traffic;
+  ErrorSources errors;  ///< realistic by default
 
   /// The meshes of the world (ground first) or of the world as surveyed.
   std::vector<TriangleMesh> worldMeshes() const;
   std::vector<TriangleMesh> mapMeshes() const;
 };
+
+/// Sets the error sources and draws what the RSUs do not state (survey error, clock offset) from them
+/// and the seed: one draw per RSU, the same for every drive of the scenario.
+void setErrorSources(Scenario& scenario, const ErrorSources& errors);
 
 /// Throws coloc::Error naming the file, line and key for unknown keys, unknown object types or LiDAR
 /// models, and values out of range.

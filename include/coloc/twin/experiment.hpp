@@ -12,6 +12,7 @@
 
 #include "coloc/smoother/smoother.hpp"
 #include "coloc/twin/experiment_config.hpp"
+#include "coloc/twin/twin_recording.hpp"
 
 namespace coloc::twin {
 
@@ -69,6 +70,13 @@ struct ExperimentResults {
   /// Per site: the odometry's variance of speed ((m/s)^2) and yaw rate ((rad/s)^2) on that drive.
   std::map<std::string, Eigen::Vector2d> estimated_twist_variance;
   std::vector<CalibrationResult> calibrations;
+  /// Each RSU's survey and clock error as drawn (dx, dy, dyaw, clock_offset) and as its noise
+  /// calibration drive found it (when `calibrate_rsus`).
+  std::vector<CalibrationResult> commissioning;
+  /// "SITE LIDAR" -> every RSU frame within coverage of the evaluated trials (attribution, refusals).
+  std::map<std::string, std::vector<RsuFrameRecord>> rsu_frames;
+  /// The same on each site's noise calibration drive, with the ideal twin's fix beside each.
+  std::map<std::string, std::vector<RsuFrameRecord>> ideal_comparison;
   std::string work_dir;  ///< the recordings
 };
 

@@ -18,8 +18,8 @@ const char* toString(RsuCovariance c);
 RsuCovariance referenceCovariance(RsuCovariance main);
 
 struct ExperimentConfig {
-  /// Scenario files, or the names of the built-in scenarios (site_a, site_b: config/scenarios/).
-  std::vector<std::string> sites = {"site_a", "site_b"};
+  /// Scenario files, or the names of the built-in scenarios (site_a, site_b, site_c: config/scenarios/).
+  std::vector<std::string> sites = {"site_a", "site_b", "site_c"};
   int trials = 10;
   std::vector<std::string> lidars = {"VLP-16", "VLP-32C"};  ///< roadside LiDAR models compared
   /// The network grid (Tables II and III): every delay crossed with every loss, on top of the fix's
@@ -58,6 +58,13 @@ struct ExperimentConfig {
   /// `calibration_clock_offset_ms`; one drive calibrates it (coloc smooth --calibrate-rsus), and the
   /// filter on a second drive runs with the miscalibrated registry, the calibrated one, and a perfect RSU.
   bool calibration = true;
+  /// The road's error sources (sim/error_sources.hpp): `real` (each site's own, the published figures
+  /// by default: RSU survey and clock, a real car's shape, range-dependent noise, dropouts) or `ideal`.
+  bool ideal_twin = false;
+  /// Calibrate every RSU (survey and clock, `coloc smooth --calibrate-rsus`) on its site's noise
+  /// calibration drive and replay the evaluated drives with the calibrated registry, as a deployment
+  /// would after commissioning; the fixes' variance is then measured after the calibration.
+  bool calibrate_rsus = true;
   std::vector<double> calibration_error = {0.15, 0.0, 0.5};  ///< [dx m, dy m, dyaw deg], surveyed minus true
   double calibration_clock_offset_ms = 20.0;                 ///< the RSU's clock minus the vehicle's
 };

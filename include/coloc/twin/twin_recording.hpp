@@ -12,6 +12,7 @@
 
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
+#include "coloc/sim/roadside_perception.hpp"
 #include "coloc/sim/scene.hpp"
 
 namespace coloc::twin {
@@ -26,7 +27,21 @@ struct TwinRecordingOptions {
   /// Also run the perception without each refinement (plain L-shape centre; no 0.8 m cut) on every
   /// RSU frame, into rsu_perception.csv and .svg: what each step buys.
   bool perception_ablation = true;
+  /// Also image every RSU frame in the ideal twin (box-shaped car, perfect survey and clock, constant
+  /// range noise, no dropouts) and fix it: the fix error the error sources cost, paired frame by frame.
+  bool ideal_comparison = false;
   std::function<void(double)> progress;  ///< share of the drive done
+};
+
+/// One RSU frame within coverage: what the perception made of it.
+struct RsuFrameRecord {
+  double distance = 0.0;       ///< m, vehicle to RSU
+  bool neighbours = false;     ///< another road user within 10 m of the ego vehicle
+  bool found = false;          ///< a fix was sent
+  sim::Refusal refusal = sim::Refusal::kNone;
+  double error = 0.0;          ///< m, planar, when found
+  double ideal_error = -1.0;   ///< m, the ideal twin's fix on the same frame (< 0: none or not run)
+  std::size_t fit_points = 0;  ///< points the L-shape fit had
 };
 
 struct TwinRecordingSummary {
@@ -36,8 +51,12 @@ struct TwinRecordingSummary {
   std::string map_dir;  ///< where the map the log goes with is
   /// Per RSU id: each fix's error (x, y) against ground truth, whether the link delivered it or not.
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
+  /// Per RSU id: each of those fixes' position as the RSU reported it (map frame, through its surveyed pose).
+  std::map<std::string, std::vector<Eigen::Vector2d>> fix_positions;
   /// Each odometry sample: (measured speed, true speed, measured yaw rate, true yaw rate).
   std::vector<Eigen::Vector4d> odometry;
+  /// Per RSU id: every frame within its coverage.
+  std::map<std::string, std::vector<RsuFrameRecord>> rsu_frames;
 };
 
 /// Throws coloc::Error if the output cannot be written.
