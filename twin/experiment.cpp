@@ -444,9 +444,32 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           results.ideal_comparison[scenario.name + " " + r.lidar_model] = f->second;
       results.estimated_twist_variance[scenario.name] = twist_variance[drive.site];
       if (config.calibrate_rsus)
-        for (const std::string& lidar : config.lidars) {
-          jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
-          jobs.back().calibrate = true;
+        for (const sim::ScenarioRsu& r : scenario.rsus) {
+          // Commissioning against the reference vehicle: its fixes matched by stamp to where the
+          // vehicle was; the evaluated drives then use the calibration, and the fixes' variance is
+          // measured as the calibrated registry passes them on.
+          const auto positions = summary.fix_positions.find(r.id);
+          const auto references = summary.fix_references.find(r.id);
+          std::vector<rsu_client::CommissioningSample> samples;
+          if (positions != summary.fix_positions.end())
+            for (std::size_t i = 0; i < positions->second.size(); ++i)
+              samples.push_back({positions->second[i], references->second[i].first, references->second[i].second});
+          const rsu_client::RsuInfo entry = registryEntry(r);
+          Commissioning c;
+          c.site = scenario.name;
+          c.lidar = r.lidar_model;
+          c.dx = r.survey_error.x(), c.dy = r.survey_error.y(), c.dyaw = r.survey_error.z(), c.clock_offset = r.clock_offset;
+          c.found = rsu_client::commissionRsu(entry.position, samples);
+          results.commissioning.push_back(c);
+          if (!c.found.determined) continue;
+          rsu_client::RsuInfo calibrated = entry;
+          calibrated.calibration = c.found.calibration;
+          commissioned[{drive.site, r.lidar_model}] = calibrated;
+          // The fixes' variance as the filter will see them: calibrated, against where the vehicle was at
+          // their (corrected) stamps.
+          const std::vector<Eigen::Vector2d>& corrected = c.found.residuals;
+          measured_variance[drive.site][r.id] = robustFixVariance(corrected, r.id);
+          results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
         }
     } else if (drive.variant.empty()) {
       for (const sim::ScenarioRsu& r : scenario.rsus)
@@ -498,36 +521,6 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     runJobs(jobs, config.jobs);
     for (Job& j : jobs) {
       results.timing.replay += j.run.replay_seconds;
-      if (j.calibrate && drive.variant == kNoiseCalibrationDrive) {
-        for (const sim::ScenarioRsu& r : scenario.rsus) {
-          if (r.lidar_model != j.run.lidar) continue;
-          CalibrationResult c;
-          c.site = scenario.name;
-          c.lidar = j.run.lidar;
-          c.dx = r.survey_error.x(), c.dy = r.survey_error.y(), c.dyaw = r.survey_error.z(), c.clock_offset = r.clock_offset;
-          if (j.calibration) c.found = *j.calibration;
-          else c.found.note = "no fix of this RSU on the drive";
-          results.commissioning.push_back(c);
-          if (!j.calibrated || !j.calibrated->calibration) continue;
-          commissioned[{drive.site, j.run.lidar}] = *j.calibrated;
-          // The fixes' variance as the calibrated registry will pass them on.
-          const rsu_client::RsuCalibrationEntry& k = *j.calibrated->calibration;
-          const Eigen::Vector2d at = registryEntry(r).position;
-          std::vector<Eigen::Vector2d> corrected;
-          const auto e = summary.fix_errors.find(r.id);
-          const auto p = summary.fix_positions.find(r.id);
-          if (e == summary.fix_errors.end() || p == summary.fix_positions.end()) continue;
-          const std::vector<Eigen::Vector2d>& errors = e->second;
-          const std::vector<Eigen::Vector2d>& positions = p->second;
-          for (std::size_t i = 0; i < errors.size(); ++i) {
-            const Eigen::Vector2d truth = positions[i] - errors[i];
-            corrected.push_back(at - Eigen::Vector2d(k.dx, k.dy) + Eigen::Rotation2Dd(-k.dyaw) * (positions[i] - at) - truth);
-          }
-          measured_variance[drive.site][r.id] = robustFixVariance(corrected, r.id);
-          results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
-        }
-        continue;
-      }
       if (j.calibrate) {
         CalibrationResult c;
         c.site = scenario.name;

@@ -295,22 +295,23 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     writeFile(out_dir + "/fix_error_by_distance.csv", csv.str());
   }
 
-  // Commissioning: each RSU's survey and clock error as drawn, and as its noise calibration drive found it.
+  // Commissioning: each RSU's survey and clock error as drawn, and as the reference vehicle found it.
   if (!results.commissioning.empty()) {
     const double deg = 180.0 / M_PI;
-    sources_md << "\nEach RSU's survey and clock error as drawn from the error sources, and as the site's noise calibration drive "
-                  "found it (`coloc smooth --calibrate-rsus`); the evaluated drives use the calibration when it is determined:\n\n"
-               << "| site | roadside LiDAR | drawn (dx, dy, dyaw, clock) | found (± sd) |\n|---|---|---|---|\n";
-    for (const CalibrationResult& cr : results.commissioning) {
-      const smoother::RsuCalibration& f = cr.found;
-      char drawn[128], found[192];
+    sources_md << "\nEach RSU's survey and clock error as drawn from the error sources, and as commissioning against the reference "
+                  "vehicle on the noise calibration drive found it (`rsu_client/commissioning`: fixes matched by stamp to the "
+                  "reference trajectory); the evaluated drives use the calibration when it is determined:\n\n"
+               << "| site | roadside LiDAR | drawn (dx, dy, dyaw, clock) | found (± sd) | fixes used / left out | residual sd |\n|---|---|---|---|---|---|\n";
+    for (const Commissioning& cr : results.commissioning) {
+      const rsu_client::CommissioningResult& f = cr.found;
+      char drawn[128], found[224];
       std::snprintf(drawn, sizeof drawn, "%.3f m, %.3f m, %.3f deg, %.2f ms", cr.dx, cr.dy, cr.dyaw * deg, cr.clock_offset * 1e3);
-      if (f.observable)
-        std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %s", f.dx, f.sd_dx, f.dy, f.sd_dy, f.dyaw * deg,
-                      f.sd_dyaw * deg, f.clock_observable ? (fmt("%.1f", f.clock_offset * 1e3) + fmt(" ± %.1f ms", f.sd_clock_offset * 1e3)).c_str() : "clock held");
-      else
-        std::snprintf(found, sizeof found, "not determined (%s): not used", f.note.c_str());
-      sources_md << "| " << cr.site << " | " << cr.lidar << " | " << drawn << " | " << found << " |\n";
+      const std::string clock =
+          f.clock_observable ? fmt("%.2f", f.calibration.clock_offset * 1e3) + fmt(" ± %.2f ms", f.sd[3] * 1e3) : std::string("clock held at 0");
+      std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %s%s", f.calibration.dx, f.sd[0], f.calibration.dy, f.sd[1],
+                    f.calibration.dyaw * deg, f.sd[2] * deg, clock.c_str(), f.determined ? "" : (" (not used: " + f.note + ")").c_str());
+      sources_md << "| " << cr.site << " | " << cr.lidar << " | " << drawn << " | " << found << " | " << f.inliers << " / " << f.outliers << " | "
+                 << fmt("%.1f cm", 100 * f.residual_sd) << " |\n";
     }
   }
 

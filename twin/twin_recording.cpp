@@ -385,8 +385,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const Eigen::Vector2d local = true_yaw.inverse() * (d.position - r.info.position);
       d.position = r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * local;
       const Eigen::Vector2d error = d.position - seen.position;
+      // Stamped on the RSU's clock, with its per-frame stamp error; where the vehicle was at that stamp.
+      const double stamp_offset = r.info.clock_offset + (errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0);
+      const sim::VehicleState at_stamp = drive.at(capture + stamp_offset);
       summary.fix_errors[r.info.id].push_back(error);
       summary.fix_positions[r.info.id].push_back(d.position);
+      summary.fix_references[r.info.id].push_back(
+          {at_stamp.position, at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw))});
       record.error = error.norm();
       keep(record);
       fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","
@@ -401,9 +406,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         continue;
       }
       io::StampedPose fix;
-      // Stamped on the RSU's clock, with its per-frame stamp error.
-      const double jitter = errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0;
-      fix.header = {at(capture) + fromSeconds(r.info.clock_offset + jitter), "map"};
+      fix.header = {at(capture) + fromSeconds(stamp_offset), "map"};
       fix.measurement.pose.position = {d.position.x(), d.position.y(), 0.0};
       fix.measurement.covariance = Matrix6d::Zero();
       fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;

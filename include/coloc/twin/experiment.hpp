@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/smoother/smoother.hpp"
 #include "coloc/twin/experiment_config.hpp"
 #include "coloc/twin/twin_recording.hpp"
@@ -39,6 +40,12 @@ struct CalibrationResult {
   std::string site, lidar;
   double dx = 0.0, dy = 0.0, dyaw = 0.0, clock_offset = 0.0;  ///< injected: m, m, rad, s
   smoother::RsuCalibration found;
+};
+/// An RSU commissioned against the reference vehicle on its site's noise calibration drive.
+struct Commissioning {
+  std::string site, lidar;
+  double dx = 0.0, dy = 0.0, dyaw = 0.0, clock_offset = 0.0;  ///< drawn: m, m, rad, s
+  rsu_client::CommissioningResult found;
 };
 inline constexpr const char* kSmootherVariant = "smoother";
 inline constexpr const char* kCalibrationDrive = "calibration drive";
@@ -70,9 +77,9 @@ struct ExperimentResults {
   /// Per site: the odometry's variance of speed ((m/s)^2) and yaw rate ((rad/s)^2) on that drive.
   std::map<std::string, Eigen::Vector2d> estimated_twist_variance;
   std::vector<CalibrationResult> calibrations;
-  /// Each RSU's survey and clock error as drawn (dx, dy, dyaw, clock_offset) and as its noise
-  /// calibration drive found it (when `calibrate_rsus`).
-  std::vector<CalibrationResult> commissioning;
+  /// Each RSU's survey and clock error as drawn and as its commissioning on the noise calibration
+  /// drive found it (when `calibrate_rsus`).
+  std::vector<Commissioning> commissioning;
   /// "SITE LIDAR" -> every RSU frame within coverage of the evaluated trials (attribution, refusals).
   std::map<std::string, std::vector<RsuFrameRecord>> rsu_frames;
   /// The same on each site's noise calibration drive, with the ideal twin's fix beside each.

@@ -53,6 +53,9 @@ struct TwinRecordingSummary {
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
   /// Per RSU id: each of those fixes' position as the RSU reported it (map frame, through its surveyed pose).
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_positions;
+  /// Per RSU id: for each of those fixes, the vehicle's true position and velocity at the fix's stamp
+  /// (what a reference vehicle's RTK/INS log gives for commissioning the RSU).
+  std::map<std::string, std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>> fix_references;
   /// Each odometry sample: (measured speed, true speed, measured yaw rate, true yaw rate).
   std::vector<Eigen::Vector4d> odometry;
   /// Per RSU id: every frame within its coverage.
