@@ -543,8 +543,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
        << ".svg)\n\n";
   if (c.sweeps) md << "## Sweeps beyond the paper (" << std::min(c.sweep_trials, c.trials) << " trial(s) per site, the sites pooled)\n\n" << sweeps_md.str() << "\n";
   if (!results.estimated_variance.empty()) {
-    md << "Measured on each site's noise calibration drive, which is not evaluated: the fixes' variance (robust, from the median "
-          "absolute error per axis): ";
+    md << "Measured on each site's noise calibration drive, which is not evaluated: the fixes' variance (a commissioned RSU's: "
+          "the mean square of its residuals against the reference vehicle; otherwise robust, from the median absolute error per axis): ";
     bool first = true;
     for (const auto& [key, v] : results.estimated_variance) {
       md << (first ? "" : ", ") << key << fmt(" %.2e m^2", v) << fmt(" (sigma %.1f cm)", 100 * std::sqrt(v));
