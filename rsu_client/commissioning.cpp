@@ -108,17 +108,26 @@ CommissioningResult fit(const Eigen::Vector2d& at, const std::vector<Commissioni
 
 }  // namespace
 
-CommissioningResult commissionRsu(const Eigen::Vector2d& at, const std::vector<CommissioningSample>& samples, const CommissioningConfig& config) {
-  if (samples.size() < config.min_fixes) {
+CommissioningResult commissionRsu(const Eigen::Vector2d& at, const std::vector<CommissioningSample>& all, const CommissioningConfig& config) {
+  // A sample with a NaN or infinite value says nothing; it is counted, not fitted.
+  std::vector<CommissioningSample> samples;
+  for (const CommissioningSample& s : all)
+    if (s.fix.allFinite() && s.reference.allFinite() && s.velocity.allFinite()) samples.push_back(s);
+  const std::size_t not_finite = all.size() - samples.size();
+  if (samples.size() < config.min_fixes || !at.allFinite()) {
     CommissioningResult out;
-    out.note = std::to_string(samples.size()) + " fixes, fewer than " + std::to_string(config.min_fixes);
+    out.not_finite = not_finite;
+    out.note = !at.allFinite() ? std::string("the RSU's registry position is not finite")
+                               : std::to_string(samples.size()) + " usable fixes, fewer than " + std::to_string(config.min_fixes);
     return out;
   }
   // With the clock if the drive separates it well enough that the survey is still determined;
   // otherwise the clock is held and the shift along the road absorbs it.
   CommissioningResult with_clock = fit(at, samples, config, true);
+  with_clock.not_finite = not_finite;
   if (with_clock.determined || !with_clock.clock_observable) return with_clock;
   CommissioningResult held = fit(at, samples, config, false);
+  held.not_finite = not_finite;
   return held.determined ? held : with_clock;
 }
 

@@ -120,12 +120,6 @@ AlignedBox fitBody(const std::vector<std::size_t>& points, const std::vector<Eig
   return alignTrueSizeBox(rectangle, xy, lidar, length, width, heading_prior);
 }
 
-Eigen::Vector2d boxCentre(const Object& o, const std::vector<Eigen::Vector3d>& foreground, const RoadsidePerceptionConfig& c,
-                          const Eigen::Vector2d& lidar, double length, double width, double heading_prior) {
-  std::vector<Eigen::Vector2d> xy;
-  return fitBody(o.points, foreground, c, lidar, length, width, heading_prior, xy).center;
-}
-
 }  // namespace
 
 VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& frame, Stamp stamp, const Eigen::Vector2d& reference,
@@ -178,6 +172,10 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.foreground_points = foreground.size();
   const auto groups = clusters(foreground, c.cluster_distance);
   std::vector<std::size_t> vehicle_points;
+  // The vehicle's lowest points, their L-shape and the true-size box (fitted once per object).
+  std::vector<Eigen::Vector2d> xy;
+  FittedRectangle fit;
+  AlignedBox box{};
   const auto finish = [&](Refusal why) {
     out.refusal = why;
     out.processing_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -250,10 +248,12 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     double best = 1e9;
     int plausible = 0;
     for (const Object* o : candidates) {
-      const Eigen::Vector2d centre = boxCentre(*o, foreground, c, lidar, length, width, heading_prior);
-      const double d = (centre - reference).norm();
+      std::vector<Eigen::Vector2d> o_xy;
+      FittedRectangle o_fit;
+      const AlignedBox o_box = fitBody(o->points, foreground, c, lidar, length, width, heading_prior, o_xy, &o_fit);
+      const double d = o_xy.size() < 3 ? 1e9 : (o_box.center - reference).norm();
       plausible += d <= R ? 1 : 0;
-      if (d < best) best = d, vehicle = o;
+      if (d < best) best = d, vehicle = o, box = o_box, fit = o_fit, xy = std::move(o_xy);
     }
     if (occluding(vehicle) >= c.occlusion_points) return finish(Refusal::kOccluded);
     if (best > R) return finish(Refusal::kNotAtPosition);
@@ -262,9 +262,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   }
   if (vehicle_points.size() < 5) return finish(Refusal::kNoVehicle);
   // 6. The lowest part of the body, the L-shape fit, the plain centre or the true-size box.
-  std::vector<Eigen::Vector2d> xy;
-  FittedRectangle fit;
-  const AlignedBox box = fitBody(vehicle_points, foreground, c, lidar, length, width, heading_prior, xy, &fit);
+  if (!c.attribute) box = fitBody(vehicle_points, foreground, c, lidar, length, width, heading_prior, xy, &fit);
   if (xy.size() < 3) return finish(Refusal::kNoVehicle);
   const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
   if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);

@@ -458,12 +458,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           // Commissioning against the reference vehicle: its fixes matched by stamp to where the
           // vehicle was; the evaluated drives then use the calibration, and the fixes' variance is
           // measured as the calibrated registry passes them on.
-          const auto positions = summary.fix_positions.find(r.id);
-          const auto references = summary.fix_references.find(r.id);
-          std::vector<rsu_client::CommissioningSample> samples;
-          if (positions != summary.fix_positions.end())
-            for (std::size_t i = 0; i < positions->second.size(); ++i)
-              samples.push_back({positions->second[i], references->second[i].first, references->second[i].second});
+          const auto found = summary.fix_samples.find(r.id);
+          const std::vector<rsu_client::CommissioningSample> samples =
+              found == summary.fix_samples.end() ? std::vector<rsu_client::CommissioningSample>{} : found->second;
           const rsu_client::RsuInfo entry = registryEntry(r);
           Commissioning c;
           c.site = scenario.name;

@@ -229,7 +229,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     double range;
     sim::LidarSpec ideal_lidar;
     std::unique_ptr<sim::RoadsidePerception> ideal_perception;
-    sim::FixConsistency consistency, ideal_consistency;
+    sim::FixConsistency consistency{}, ideal_consistency{};
   };
   std::vector<Rsu> rsus;
   for (const sim::ScenarioRsu& r : scenario.rsus) {
@@ -249,7 +249,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       c.height_cut = kVariants[v].height_cut;
       perception.emplace_back(reference, mount, c);
     }
-    Rsu rsu{r, lidar, std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range, {}, nullptr, {}, {}};
+    Rsu rsu{r, lidar, std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range, {}, nullptr};
     if (ideal_world) {
       rsu.ideal_lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), sim::ErrorSources::ideal());
       rsu.ideal_perception = std::make_unique<sim::RoadsidePerception>(frameOf(rsu.ideal_lidar, surveyed, pose, ideal_rng), mount);
@@ -389,9 +389,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const double stamp_offset = r.info.clock_offset + (errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0);
       const sim::VehicleState at_stamp = drive.at(capture + stamp_offset);
       summary.fix_errors[r.info.id].push_back(error);
-      summary.fix_positions[r.info.id].push_back(d.position);
-      summary.fix_references[r.info.id].push_back(
-          {at_stamp.position, at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw))});
+      summary.fix_samples[r.info.id].push_back(
+          {d.position, at_stamp.position, at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw))});
       record.error = error.norm();
       keep(record);
       fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","

@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "coloc/rsu_client/commissioning.hpp"
@@ -74,6 +75,18 @@ TEST(Commissioning, FixesFarOffAreLeftOutNotFitted) {
   ASSERT_TRUE(r.determined) << r.note;
   EXPECT_GE(r.outliers, samples.size() / 15);
   EXPECT_NEAR(r.calibration.dy, 0.05, 0.005);
+}
+
+TEST(Commissioning, SamplesWithNaNOrInfiniteValuesAreCountedAndLeftOut) {
+  const Eigen::Vector3d survey(0.02, 0.01, 0.0);
+  auto samples = drive({100, 0}, survey, 0.0, 0.01, accelerating, 0.0, 5);
+  samples[2].fix.x() = std::nan("");
+  samples[7].velocity.y() = std::numeric_limits<double>::infinity();
+  const CommissioningResult r = commissionRsu(Eigen::Vector2d(100, 0) + survey.head<2>(), samples);
+  EXPECT_EQ(r.not_finite, 2u);
+  ASSERT_TRUE(r.determined) << r.note;
+  EXPECT_NEAR(r.calibration.dx, 0.02, 0.005);
+  EXPECT_FALSE(commissionRsu({std::nan(""), 0}, samples).determined);
 }
 
 TEST(Commissioning, TooFewFixesDetermineNothing) {

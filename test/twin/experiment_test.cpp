@@ -45,6 +45,10 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_NE(errorOf("rsu_covariance: guessed\n").find("exp.yaml:1: rsu_covariance: expected one of published, standard_deviation, estimated"),
             std::string::npos);
   EXPECT_EQ(parseExperimentConfig("rsu_covariance: estimated\n", "exp.yaml").rsu_covariance, RsuCovariance::kEstimated);
+  EXPECT_TRUE(parseExperimentConfig("error_sources: ideal\n", "exp.yaml").ideal_twin);
+  EXPECT_FALSE(parseExperimentConfig("rsu_calibration: none\n", "exp.yaml").calibrate_rsus);
+  EXPECT_NE(errorOf("error_sources: perfect\n").find("error_sources: expected one of real, ideal"), std::string::npos);
+  EXPECT_NE(errorOf("rsu_calibration: yes\n").find("rsu_calibration: expected one of noise_drive, none"), std::string::npos);
 }
 
 TEST(ExperimentConfig, BuiltInScenariosAreTheShippedFiles) {

@@ -25,9 +25,10 @@ struct CommissioningResult {
   bool determined = false;        ///< sd within 1 cm / 0.1 deg with at least `min_fixes` inliers
   bool clock_observable = false;  ///< the drive separates the clock from the along-road shift; else held at 0
   std::size_t inliers = 0, outliers = 0;
+  std::size_t not_finite = 0;     ///< samples with a NaN or infinite value, left out
   double residual_sd = 0.0;       ///< m per axis, of the corrected fixes against the reference
   std::string note;               ///< why not determined
-  /// Per sample: the corrected fix minus the reference at its stamp (corrected for the clock), m.
+  /// Per finite sample: the corrected fix minus the reference at its stamp (corrected for the clock), m.
   std::vector<Eigen::Vector2d> residuals;
 };
 

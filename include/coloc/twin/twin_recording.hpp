@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/roadside_perception.hpp"
@@ -51,11 +52,10 @@ struct TwinRecordingSummary {
   std::string map_dir;  ///< where the map the log goes with is
   /// Per RSU id: each fix's error (x, y) against ground truth, whether the link delivered it or not.
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
-  /// Per RSU id: each of those fixes' position as the RSU reported it (map frame, through its surveyed pose).
-  std::map<std::string, std::vector<Eigen::Vector2d>> fix_positions;
-  /// Per RSU id: for each of those fixes, the vehicle's true position and velocity at the fix's stamp
-  /// (what a reference vehicle's RTK/INS log gives for commissioning the RSU).
-  std::map<std::string, std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>> fix_references;
+  /// Per RSU id: each of those fixes as the RSU reported it (through its surveyed pose) with the
+  /// vehicle's true position and velocity at the fix's stamp: what commissioning the RSU against a
+  /// reference vehicle's RTK/INS log takes.
+  std::map<std::string, std::vector<rsu_client::CommissioningSample>> fix_samples;
   /// Each odometry sample: (measured speed, true speed, measured yaw rate, true yaw rate).
   std::vector<Eigen::Vector4d> odometry;
   /// Per RSU id: every frame within its coverage.
