@@ -240,6 +240,18 @@ const std::vector<Key>& keys() {
       {"pipeline", "speed_scale_memory", "m", "travel over which old comparisons of NDT and odometry distance fade to 1/e",
        [](const C& c) { return show(c.pipeline.speed_scale_memory); },
        [](const R& r, const N& n, const S& k, C& c) { c.pipeline.speed_scale_memory = r.inRange(n, k, 10.0, 1e6); }},
+      {"pipeline", "yaw_rate_bias_estimation", "", "learn the odometry's yaw-rate bias (gyro) from NDT's heading changes and remove it from twists",
+       [](const C& c) { return S(c.pipeline.yaw_rate_bias_estimation ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.yaw_rate_bias_estimation = r.flag(n, k); }},
+      {"pipeline", "yaw_rate_bias_memory", "s", "time over which old comparisons of NDT and odometry heading change fade to 1/e",
+       [](const C& c) { return show(c.pipeline.yaw_rate_bias_memory); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.yaw_rate_bias_memory = r.inRange(n, k, 5.0, 1e6); }},
+      {"pipeline", "mount_yaw_estimation", "", "learn the LiDAR's mounting yaw (NDT's heading minus the direction of travel) and correct NDT's poses by it",
+       [](const C& c) { return S(c.pipeline.mount_yaw_estimation ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.mount_yaw_estimation = r.flag(n, k); }},
+      {"pipeline", "mount_yaw_memory", "m", "travel over which old comparisons of NDT's heading and its direction of travel fade to 1/e",
+       [](const C& c) { return show(c.pipeline.mount_yaw_memory); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.mount_yaw_memory = r.inRange(n, k, 10.0, 1e6); }},
       // ---- messages
       {"messages", "zero_variance_is_unmeasured", "", "read a 0 variance in a message as +inf, as ROS drivers write 0 for what they do not estimate",
        [](const C& c) { return S(c.messages.zero_variance_is_unmeasured ? "true" : "false"); },
@@ -261,6 +273,16 @@ const std::vector<Key>& keys() {
        [](const R& r, const N& n, const S& k, C& c) {
          c.replay.ground_truth_max_gap = r.inRange(n, k, 0.0, 10.0);
          if (c.replay.ground_truth_max_gap == 0.0) r.fail(n, k, "must be > 0"); }},
+      {"replay", "input_stretch_length", "m", "each pose input beside the fused pose at its stamps: road per stretch when judging where the input is accurate",
+       [](const C& c) { return show(c.replay.input_stretch_length); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         c.replay.input_stretch_length = r.inRange(n, k, 0.0, 1e4);
+         if (c.replay.input_stretch_length == 0.0) r.fail(n, k, "must be > 0"); }},
+      {"replay", "input_accurate_below", "m", "a stretch where the input's mean planar error is below this counts as one where it is accurate",
+       [](const C& c) { return show(c.replay.input_accurate_below); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         c.replay.input_accurate_below = r.inRange(n, k, 0.0, 1e3);
+         if (c.replay.input_accurate_below == 0.0) r.fail(n, k, "must be > 0"); }},
       // ---- smoother
       {"smoother", "estimate_noise", "", "measure each source's noise on the drive instead of taking the messages' covariances as given",
        [](const C& c) { return S(c.smoother.estimate_noise ? "true" : "false"); },

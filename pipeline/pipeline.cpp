@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <deque>
 #include <thread>
 #include <variant>
 
@@ -11,6 +12,8 @@
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "inbox.hpp"
 #include "speed_scale.hpp"
+#include "mount_yaw.hpp"
+#include "yaw_rate_bias.hpp"
 
 namespace coloc::pipeline {
 
@@ -148,12 +151,21 @@ struct Pipeline::Impl {
   std::optional<rsu_client::FixChecker> checker;
   std::map<std::string, fusion::SourceId> fix_sources;  // by RSU id
   SpeedScaleEstimator speed_scale;
+  YawRateBiasEstimator yaw_rate_bias;
+  MountYawEstimator mount_yaw;
+  Eigen::Isometry3d base_to_lidar = Eigen::Isometry3d::Identity();  // the configured extrinsic
   bool first_input_seen = false;
   Stamp clock = 0;
   bool clock_set = false;
   PipelineReport report;
   std::function<void(const fusion::Estimate&)> on_estimate;
   std::function<void(const std::string&, const PoseMeasurement&)> on_pose_input;
+  std::function<void(const std::string&, const fusion::Estimate&)> on_pose_settled;
+  struct Settling {
+    std::string source;
+    Stamp stamp, fed;  ///< the pose's stamp, and the pipeline's clock when the filter took it
+  };
+  std::deque<Settling> settling;
   std::function<void(const std::string&, const TwistMeasurement&, const TwistMeasurement&)> on_twist_input;
   std::function<void(const std::string&)> on_rejection;
 
@@ -171,7 +183,11 @@ struct Pipeline::Impl {
         step(static_cast<Duration>(std::llround(1e9 / c.fusion.predict_frequency))),
         now(options.clock ? options.clock : std::function<Stamp()>(rsu_client::systemNow)),
         localizer(c.fusion),
-        speed_scale(SpeedScaleConfig{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory}) {
+        speed_scale(SpeedScaleConfig{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory}),
+        yaw_rate_bias(YawRateBiasConfig{c.pipeline.yaw_rate_bias_estimation && options.map.has_value(), 2.0, c.pipeline.yaw_rate_bias_memory}),
+        mount_yaw(MountYawConfig{c.pipeline.mount_yaw_estimation && options.map.has_value(), 5.0, c.pipeline.mount_yaw_memory}) {
+    const Vector6d& e = c.ndt.source.lidar_pose;
+    base_to_lidar = Eigen::Translation3d(e.head<3>()) * Eigen::Quaterniond(quaternionFromRollPitchYaw(e[3], e[4], e[5]));
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
       if (v.rejected()) reject(v.message());
     });
@@ -225,6 +241,7 @@ struct Pipeline::Impl {
         for (Stamp tick = latest_tick + step; tick <= now; tick += step) {
           localizer.advanceTo(tick);
           emit(*localizer.estimate());
+          settle(tick);
         }
       }
     }
@@ -238,13 +255,39 @@ struct Pipeline::Impl {
     const bool was_initialized = localizer.initialized();
     const fusion::Verdict v = localizer.feedPose(source, pose);
     if (!was_initialized && localizer.initialized()) emit(*localizer.estimate());
+    if (on_pose_settled && !v.rejected()) settling.push_back({source_names[source], pose.stamp, clock});
     return v;
+  }
+
+  // The filter's estimate for the stamp of each pose it took, once the pose's smoothing is over: what
+  // it knows of that moment from everything stamped up to it, as the source's own pose does.
+  void settle(Stamp tick) {
+    const Duration smoothing = (config.fusion.pose_smoothing_steps + 1) * step;
+    while (!settling.empty() && settling.front().fed + smoothing <= tick) {
+      if (const auto e = localizer.estimateAt(settling.front().stamp)) on_pose_settled(settling.front().source, *e);
+      settling.pop_front();
+    }
   }
 
   void handle(const ndt::ScanOutcome& outcome, Stamp scan_stamp) {
     if (!outcome.produced) return reject("scan stamped " + formatSeconds(scan_stamp) + ": " + outcome.detail);
-    // NDT's poses, where the filter takes them, anchor the odometry's speed scale.
-    if (!feedPose(ndt_id, outcome.pose).rejected()) speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
+    // The LiDAR's mounting yaw as learned so far: the LiDAR is where NDT put it, the car is turned
+    // back by the yaw about the LiDAR's own axis (B = B_ndt E Rz(-yaw) E^-1, E the configured extrinsic).
+    PoseMeasurement pose = outcome.pose;
+    const double raw_yaw = rollPitchYaw(pose.pose.orientation)[2];
+    if (mount_yaw.usable()) {
+      const Eigen::Isometry3d ndt_base = Eigen::Translation3d(pose.pose.position) * pose.pose.orientation;
+      const Eigen::Isometry3d base = ndt_base * base_to_lidar * Eigen::AngleAxisd(-mount_yaw.yaw(), Eigen::Vector3d::UnitZ()) * base_to_lidar.inverse();
+      pose.pose.position = base.translation();
+      pose.pose.orientation = Eigen::Quaterniond(base.rotation()).normalized();
+    }
+    // NDT's poses, where the filter takes them, anchor the odometry's speed scale and yaw-rate bias
+    // and the mounting yaw (each from NDT's poses as matched: the yaw's differences do not see it).
+    if (!feedPose(ndt_id, pose).rejected()) {
+      speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
+      yaw_rate_bias.addPose(outcome.pose.stamp, raw_yaw);
+      mount_yaw.addPose(outcome.pose.pose.position.head<2>(), raw_yaw);
+    }
   }
 
   void apply(Input& input, Stamp arrival) {
@@ -268,11 +311,16 @@ struct Pipeline::Impl {
     } else if (auto* result = std::get_if<NdtResult>(&input)) {
       handle(result->outcome, result->scan_stamp);
     } else if (auto* twist = std::get_if<TwistInput>(&input)) {
-      // A twist that measures speed (odometry, not an IMU) is scaled by what NDT taught about it.
+      // A twist that measures speed (odometry, not an IMU) is scaled by what NDT taught about it, and
+      // one that measures yaw rate has the bias NDT showed taken out.
       TwistMeasurement t = twist->twist;
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
+      }
+      if (std::isfinite(t.covariance(5, 5))) {
+        yaw_rate_bias.addTwist(t.stamp, t.angular.z());
+        t.angular.z() -= yaw_rate_bias.bias();
       }
       if (on_twist_input) on_twist_input(source_names[twist->source], t, twist->twist);
       localizer.feedTwist(twist->source, t);
@@ -355,6 +403,11 @@ void Pipeline::onEstimate(std::function<void(const fusion::Estimate&)> callback)
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_estimate = std::move(callback);
 }
+void Pipeline::onPoseSettled(std::function<void(const std::string&, const fusion::Estimate&)> callback) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  impl_->on_pose_settled = std::move(callback);
+}
+
 void Pipeline::onPoseInput(std::function<void(const std::string&, const PoseMeasurement&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_pose_input = std::move(callback);
@@ -403,6 +456,10 @@ PipelineReport Pipeline::report() const {
     for (const auto& [id, c] : impl_->checker->counters()) r.fixes[id] = c;
   r.speed_scale = impl_->speed_scale.scale();
   r.speed_scale_distance = impl_->speed_scale.comparedDistance();
+  r.yaw_rate_bias = impl_->yaw_rate_bias.bias();
+  r.yaw_rate_bias_time = impl_->yaw_rate_bias.comparedTime();
+  r.mount_yaw = impl_->mount_yaw.yaw();
+  r.mount_yaw_distance = impl_->mount_yaw.comparedDistance();
   return r;
 }
 

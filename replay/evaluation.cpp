@@ -27,10 +27,83 @@ std::vector<ErrorSample> evaluate(const std::vector<io::TrajectoryPoint>& estima
       const Eigen::Vector2d estimate = p.pose.position.head<2>();
       const Eigen::Vector2d d = estimate - t->position;
       const Eigen::Vector2d ahead(std::cos(t->heading), std::sin(t->heading));
-      errors.push_back({p.stamp, estimate, t->position, d.norm(), d.dot(ahead), ahead.x() * d.y() - ahead.y() * d.x()});
+      errors.push_back({p.stamp, estimate, t->position, d.norm(), d.dot(ahead), ahead.x() * d.y() - ahead.y() * d.x(),
+                        wrapAngle(rollPitchYaw(p.pose.orientation)[2] - t->heading)});
     }
   }
   return errors;
+}
+
+std::vector<ErrorSample> evaluateAt(const std::vector<io::TrajectoryPoint>& estimates, const std::vector<Stamp>& stamps,
+                                    const std::vector<io::TrajectoryPoint>& truth, Duration max_gap) {
+  std::vector<io::TrajectoryPoint> at;
+  for (Stamp s : stamps)
+    if (const auto e = truthAt(estimates, s, max_gap)) {  // the same interpolation serves any trajectory
+      io::TrajectoryPoint p;
+      p.stamp = s;
+      p.pose.position.head<2>() = e->position;
+      p.pose.orientation = Eigen::AngleAxisd(e->heading, Eigen::Vector3d::UnitZ());
+      at.push_back(p);
+    }
+  return evaluate(at, truth, max_gap);
+}
+
+InputComparison compareWithInput(const std::vector<ErrorSample>& input, const std::vector<ErrorSample>& fused_at_input,
+                                 const std::vector<ErrorSample>& settled_at_input, double stretch_length, double accurate_below) {
+  InputComparison c;
+  c.stretch_length = stretch_length;
+  c.accurate_below = accurate_below;
+  // Pair by stamp; all three are in stamp order.
+  struct Triple {
+    const ErrorSample* input;
+    double fused, settled;
+  };
+  std::vector<Triple> pairs;
+  for (std::size_t i = 0, j = 0, k = 0; i < input.size() && j < fused_at_input.size() && k < settled_at_input.size();) {
+    const Stamp s = std::max({input[i].stamp, fused_at_input[j].stamp, settled_at_input[k].stamp});
+    if (input[i].stamp < s) ++i;
+    else if (fused_at_input[j].stamp < s) ++j;
+    else if (settled_at_input[k].stamp < s) ++k;
+    else pairs.push_back({&input[i++], fused_at_input[j++].error, settled_at_input[k++].error});
+  }
+  c.samples = pairs.size();
+  if (pairs.empty()) return c;
+  for (const Triple& p : pairs) {
+    c.input_mean += p.input->error;
+    c.fused_mean += p.fused;
+    c.settled_mean += p.settled;
+    c.mean_square_xy += 0.5 * p.input->error * p.input->error;
+    c.yaw_mean += p.input->heading_error;
+  }
+  const double n = static_cast<double>(pairs.size());
+  c.input_mean /= n, c.fused_mean /= n, c.settled_mean /= n, c.mean_square_xy /= n, c.yaw_mean /= n;
+  for (const Triple& p : pairs) c.yaw_variance += (p.input->heading_error - c.yaw_mean) * (p.input->heading_error - c.yaw_mean) / n;
+  // Stretches by distance along the true path.
+  std::size_t begin = 0;
+  double along = 0.0;
+  double input_sum = 0.0, fused_sum = 0.0, settled_sum = 0.0;
+  auto close = [&](std::size_t end) {
+    double in = 0.0, fu = 0.0, se = 0.0;
+    for (std::size_t k = begin; k < end; ++k) in += pairs[k].input->error, fu += pairs[k].fused, se += pairs[k].settled;
+    if (end > begin && in / static_cast<double>(end - begin) < accurate_below) {
+      c.accurate_samples += end - begin;
+      input_sum += in, fused_sum += fu, settled_sum += se;
+    }
+    begin = end;
+    along = 0.0;
+  };
+  for (std::size_t k = 1; k < pairs.size(); ++k) {
+    along += (pairs[k].input->truth - pairs[k - 1].input->truth).norm();
+    if (along >= stretch_length) close(k);
+  }
+  close(pairs.size());
+  if (c.accurate_samples > 0) {
+    const double m = static_cast<double>(c.accurate_samples);
+    c.accurate_input_mean = input_sum / m;
+    c.accurate_fused_mean = fused_sum / m;
+    c.accurate_settled_mean = settled_sum / m;
+  }
+  return c;
 }
 
 ErrorStats errorStats(const std::vector<ErrorSample>& errors) {

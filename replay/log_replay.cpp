@@ -179,6 +179,7 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
       result.fused_state_covariances.push_back(e.state_covariance);
     }
   });
+  pipe.onPoseSettled([&](const std::string& source, const fusion::Estimate& e) { result.settled_poses[source].push_back({e.stamp, e.pose}); });
   pipe.onPoseInput([&](const std::string& source, const PoseMeasurement& p) {
     result.pose_inputs.push_back({p.stamp, p.pose});
     result.pose_input_sources.push_back(source);
@@ -213,6 +214,10 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   result.fixes = report.fixes;
   result.speed_scale = report.speed_scale;
   result.speed_scale_distance = report.speed_scale_distance;
+  result.yaw_rate_bias = report.yaw_rate_bias;
+  result.yaw_rate_bias_time = report.yaw_rate_bias_time;
+  result.mount_yaw = report.mount_yaw;
+  result.mount_yaw_distance = report.mount_yaw_distance;
 }
 
 }  // namespace
@@ -247,6 +252,14 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     for (auto& [source, inputs] : by_source) {
       std::sort(inputs.begin(), inputs.end(), [](const io::TrajectoryPoint& a, const io::TrajectoryPoint& b) { return a.stamp < b.stamp; });
       result.input_errors[source] = evaluate(inputs, result.ground_truth, max_gap);
+      std::vector<Stamp> stamps;
+      for (const ErrorSample& e : result.input_errors[source]) stamps.push_back(e.stamp);
+      result.fused_at_inputs[source] = evaluateAt(result.fused, stamps, result.ground_truth, max_gap);
+      std::vector<io::TrajectoryPoint>& settled = result.settled_poses[source];
+      std::sort(settled.begin(), settled.end(), [](const io::TrajectoryPoint& a, const io::TrajectoryPoint& b) { return a.stamp < b.stamp; });
+      result.settled_at_inputs[source] = evaluate(settled, result.ground_truth, max_gap);
+      result.input_comparison[source] = compareWithInput(result.input_errors[source], result.fused_at_inputs[source], result.settled_at_inputs[source],
+                                                         config.replay.input_stretch_length, config.replay.input_accurate_below);
     }
   }
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -1,5 +1,6 @@
 // summary.json and error.csv of a replay: everything in them follows from the log and the config, so
 // that reruns give the same bytes; run times are reported apart (timing.json).
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -42,12 +43,28 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
   j["position_error"] = errorJson(errors, "error.csv");
   if (!input_errors.empty()) {
     auto& inputs = j["input_error"] = nlohmann::ordered_json::object();
-    for (const auto& [source, samples] : input_errors) inputs[source] = errorJson(samples);
+    for (const auto& [source, samples] : input_errors) {
+      inputs[source] = errorJson(samples);
+      const auto c = input_comparison.find(source);
+      if (inputs[source].is_null() || c == input_comparison.end() || c->second.samples == 0) continue;
+      const InputComparison& k = c->second;
+      // The filter beside its input at the input's stamps, and the input's mean square per axis: what
+      // a drive with a reference measures for the source's fixed covariance.
+      inputs[source]["fused_at_stamps"] = {{"samples", k.samples}, {"input_mean_m", k.input_mean}, {"fused_mean_m", k.fused_mean},
+                                           {"settled_mean_m", k.settled_mean}};
+      inputs[source]["where_accurate"] = {{"stretch_m", k.stretch_length}, {"input_mean_below_m", k.accurate_below},
+                                          {"samples", k.accurate_samples}, {"input_mean_m", k.accurate_input_mean},
+                                          {"fused_mean_m", k.accurate_fused_mean}, {"settled_mean_m", k.accurate_settled_mean}};
+      inputs[source]["covariance_estimate"] = {{"xy_mean_square_m2", k.mean_square_xy}, {"yaw_variance_rad2", k.yaw_variance},
+                                               {"yaw_mean_rad", k.yaw_mean}};
+    }
     inputs["file"] = "input_error.csv";
   }
   if (ndt_used) {
     j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(ndt, map, scans_without_guess));
     j["odometry_speed_scale"] = {{"scale", speed_scale}, {"compared_m", speed_scale_distance}};
+    j["odometry_yaw_rate_bias"] = {{"bias_rad_s", yaw_rate_bias}, {"compared_s", yaw_rate_bias_time}};
+    j["lidar_mount_yaw"] = {{"yaw_rad", mount_yaw}, {"compared_m", mount_yaw_distance}};
   }
   if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes));
   j["rejections_first"] = rejections;
@@ -57,11 +74,11 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
 void ReplayResult::writeErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
-  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m\n";
+  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg\n";
   char line[320];
   for (const ErrorSample& s : errors) {
-    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(),
-                  s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across);
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(),
+                  s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI);
     out << line;
   }
 }
@@ -69,12 +86,12 @@ void ReplayResult::writeErrorCsv(const std::string& path) const {
 void ReplayResult::writeInputErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
-  out << "stamp_s,source,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m\n";
+  out << "stamp_s,source,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg\n";
   char line[320];
   for (const auto& [source, samples] : input_errors)
     for (const ErrorSample& s : samples) {
-      std::snprintf(line, sizeof line, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), source.c_str(),
-                    s.estimate.x(), s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across);
+      std::snprintf(line, sizeof line, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f\n", formatSeconds(s.stamp).c_str(), source.c_str(),
+                    s.estimate.x(), s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI);
       out << line;
     }
 }

@@ -13,6 +13,9 @@ ErrorSources ErrorSources::ideal() {
   e.range_noise_per_m = 0.0;
   e.dropout = 0.0;
   e.dropout_at_max_range = 0.0;
+  e.lidar_mount_yaw = 0.0;
+  e.map_position_sd = 0.0;
+  e.map_yaw_sd = 0.0;
   return e;
 }
 

@@ -82,11 +82,12 @@ SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& 
   return o;
 }
 
-ErrorSources readErrors(const Reader& r, const YAML::Node& n) {
+ErrorSources readErrors(const Reader& r, const YAML::Node& n, const ErrorSources& base = {}) {
   r.keys(n, "errors", {"preset", "survey_position_sd", "survey_yaw_sd_deg", "clock_offset_sd_ms", "clock_jitter_sd_ms", "vehicle_body",
-                       "range_noise", "range_noise_per_m", "dropout", "dropout_at_max_range"});
-  ErrorSources e;
-  if (n["preset"] && r.choice(n["preset"], "errors.preset", {"real", "ideal"}) == "ideal") e = ErrorSources::ideal();
+                       "range_noise", "range_noise_per_m", "dropout", "dropout_at_max_range", "lidar_mount_yaw_deg",
+                       "map_position_sd", "map_yaw_sd_deg", "map_error_length"});
+  ErrorSources e = base;
+  if (n["preset"]) e = r.choice(n["preset"], "errors.preset", {"real", "ideal"}) == "ideal" ? ErrorSources::ideal() : ErrorSources{};
   if (n["survey_position_sd"]) e.survey_position_sd = r.inRange(n["survey_position_sd"], "errors.survey_position_sd", 0.0, 5.0);
   if (n["survey_yaw_sd_deg"]) e.survey_yaw_sd = r.inRange(n["survey_yaw_sd_deg"], "errors.survey_yaw_sd_deg", 0.0, 10.0) * M_PI / 180.0;
   if (n["clock_offset_sd_ms"]) e.clock_offset_sd = 1e-3 * r.inRange(n["clock_offset_sd_ms"], "errors.clock_offset_sd_ms", 0.0, 1000.0);
@@ -96,6 +97,13 @@ ErrorSources readErrors(const Reader& r, const YAML::Node& n) {
   if (n["range_noise_per_m"]) e.range_noise_per_m = r.inRange(n["range_noise_per_m"], "errors.range_noise_per_m", 0.0, 0.1);
   if (n["dropout"]) e.dropout = r.inRange(n["dropout"], "errors.dropout", 0.0, 0.99);
   if (n["dropout_at_max_range"]) e.dropout_at_max_range = r.inRange(n["dropout_at_max_range"], "errors.dropout_at_max_range", 0.0, 1.0);
+  if (n["map_position_sd"]) e.map_position_sd = r.inRange(n["map_position_sd"], "errors.map_position_sd", 0.0, 5.0);
+  if (n["map_yaw_sd_deg"]) e.map_yaw_sd = r.inRange(n["map_yaw_sd_deg"], "errors.map_yaw_sd_deg", 0.0, 10.0) * M_PI / 180.0;
+  if (n["map_error_length"]) {
+    e.map_error_length = r.inRange(n["map_error_length"], "errors.map_error_length", 0.0, 1e5);
+    if (e.map_error_length == 0.0) r.fail(n["map_error_length"], "errors.map_error_length", "must be > 0");
+  }
+  if (n["lidar_mount_yaw_deg"]) e.lidar_mount_yaw = r.inRange(n["lidar_mount_yaw_deg"], "errors.lidar_mount_yaw_deg", -10.0, 10.0) * M_PI / 180.0;
   return e;
 }
 
@@ -112,6 +120,10 @@ TrafficVehicle readTraffic(const Reader& r, const YAML::Node& n, const std::stri
 }
 
 }  // namespace
+
+ErrorSources readErrorSources(const YamlReader& reader, const YAML::Node& node, const ErrorSources& base) {
+  return readErrors(Reader(reader.source()), node, base);
+}
 
 void setErrorSources(Scenario& s, const ErrorSources& errors) {
   s.errors = errors;

@@ -64,6 +64,8 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 (unsigned long long)n.no_map, (unsigned long long)r.scans_without_guess, n.scans ? n.align_ms_total / n.scans : 0.0,
                 r.map.builds);
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
+    std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
+    std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);
   }
   if (!r.errors.empty()) {
     const ErrorStats s = r.errorStats();

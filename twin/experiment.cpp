@@ -43,9 +43,14 @@ std::string rsuIdFor(const sim::ScenarioRsu& rsu, const std::string& lidar) { re
 
 // The site's scenario with every compared LiDAR model mounted at each of its RSUs (one virtual sensor
 // each: they do not disturb one another, so one drive serves all).
-sim::Scenario siteScenario(const std::string& site, const std::vector<std::string>& lidars, bool ideal) {
+sim::Scenario siteScenario(const std::string& site, const ExperimentConfig& config) {
   sim::Scenario s = sim::parseScenario(scenarioText(site), site);
-  if (ideal) sim::setErrorSources(s, sim::ErrorSources::ideal());
+  if (config.ideal_twin) sim::setErrorSources(s, sim::ErrorSources::ideal());
+  if (!config.errors.empty()) {
+    const YamlReader r("experiment errors");
+    sim::setErrorSources(s, sim::readErrorSources(r, r.parse(config.errors), s.errors));
+  }
+  const std::vector<std::string>& lidars = config.lidars;
   std::vector<sim::ScenarioRsu> rsus;
   for (const sim::ScenarioRsu& r : s.rsus)
     for (const std::string& lidar : lidars) {
@@ -61,6 +66,7 @@ sim::Scenario siteScenario(const std::string& site, const std::vector<std::strin
 SiteInfo siteInfo(const sim::Scenario& s) {
   SiteInfo info;
   info.name = s.name;
+  info.cruise_speed = s.speed.cruise;
   const sim::Drive drive(sim::Route(s.route_start, s.route_heading, s.route), s.speed);
   // Sample the path finely and find where each RSU is nearest.
   std::vector<std::pair<double, Eigen::Vector2d>> path;
@@ -149,6 +155,7 @@ void runJob(Job& job) {
     r = replay::replayLog(job.log, options);
   }
   fillRun(job.run, r.ground_truth, r.errors, job.rsu_positions);
+  if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) job.run.ndt = c->second;
   for (const fusion::SourceReport& s : r.sources)
     if (!job.fix_topic.empty() && s.name == job.fix_topic) {
       job.run.fixes_applied = s.counters.applied;
@@ -229,6 +236,14 @@ Eigen::Vector2d odometryVariance(const std::vector<Eigen::Vector4d>& samples, co
   return {speed / n, yaw_rate / n};
 }
 
+// NDT's variance per axis as the filter gets it, from its own poses on a drive with ground truth: the
+// mean square (tails included, as for the fixes), x and y pooled; yaw about its mean, which is the
+// LiDAR's mounting yaw that the pipeline learns and takes out.
+Eigen::Vector2d ndtVariance(const replay::InputComparison& ndt, const std::string& site) {
+  if (ndt.samples < 20) throw Error(site + ": too few NDT poses on the noise calibration drive to estimate their covariance");
+  return {ndt.mean_square_xy, ndt.yaw_variance};
+}
+
 }  // namespace
 
 std::string ExperimentRun::label() const {
@@ -287,11 +302,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<sim::Scenario> scenarios;
   std::vector<std::string> maps(config.sites.size());
   for (const std::string& site : config.sites) {
-    scenarios.push_back(siteScenario(site, config.lidars, config.ideal_twin));
+    scenarios.push_back(siteScenario(site, config));
     results.sites.push_back(siteInfo(scenarios.back()));
   }
   std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU id -> variance
   std::vector<Eigen::Vector2d> twist_variance(config.sites.size(), Eigen::Vector2d::Zero());  // per site: vx, wz
+  std::vector<std::optional<Eigen::Vector2d>> ndt_variance(config.sites.size());  // per site: x/y, yaw
 
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
   struct Recorded {
@@ -390,6 +406,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.map = maps[drive.site];
       job.config = fuse;
       job.rsu_positions = rsu_positions;
+      if (const auto& v = ndt_variance[drive.site]) {
+        Vector6d& cov = job.config.ndt.source.ndt.fixed_covariance;
+        cov[0] = cov[1] = (*v)[0];
+        cov[5] = (*v)[1];
+      }
       if (config.twist_covariance_estimated) {
         pipeline::InputConfig twist;
         twist.role = pipeline::InputRole::kTwist;
@@ -449,6 +470,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
       }
       twist_variance[drive.site] = odometryVariance(summary.odometry, scenario.name);
+      // NDT alone on this drive, against ground truth: its covariance for the evaluated drives.
+      if (config.ndt_covariance_estimated) jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
       for (const sim::ScenarioRsu& r : scenario.rsus)
         if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end())
           results.ideal_comparison[scenario.name + " " + r.lidar_model] = f->second;
@@ -528,6 +551,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     runJobs(jobs, config.jobs);
     for (Job& j : jobs) {
       results.timing.replay += j.run.replay_seconds;
+      if (drive.variant == kNoiseCalibrationDrive) {
+        ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
+        results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
+        continue;  // never evaluated
+      }
       if (j.calibrate) {
         CalibrationResult c;
         c.site = scenario.name;

@@ -1,8 +1,11 @@
 #include "coloc/twin/experiment_config.hpp"
 
+#include "coloc/sim/scene.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 #include "builtin_scenarios.hpp"
@@ -65,16 +68,23 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     else if (key == "speeds") c.speeds = r.numberList(v, key, 1.0, 40.0);
     else if (key == "smoother") c.smoother = r.flag(v, key);
     else if (key == "twist_covariance") c.twist_covariance_estimated = r.choice(v, key, {"estimated", "message"}) == "estimated";
+    else if (key == "ndt_covariance") c.ndt_covariance_estimated = r.choice(v, key, {"estimated", "published"}) == "estimated";
     else if (key == "calibration") c.calibration = r.flag(v, key);
     else if (key == "rsu_calibration") c.calibrate_rsus = r.choice(v, key, {"noise_drive", "none"}) == "noise_drive";
     else if (key == "error_sources") c.ideal_twin = r.choice(v, key, {"real", "ideal"}) == "ideal";
+    else if (key == "errors") {
+      sim::readErrorSources(r, v, {});  // checked here, where the file and line are known
+      YAML::Emitter out;
+      out << v;
+      c.errors = out.c_str();
+    }
     else if (key == "calibration_error") {
       c.calibration_error = r.numberList(v, key, -30.0, 30.0);
       if (c.calibration_error.size() != 3 || std::abs(c.calibration_error[0]) > 10.0 || std::abs(c.calibration_error[1]) > 10.0)
         r.fail(v, key, "expected [dx, dy, dyaw_deg] within 10 m and 30 deg");
     } else if (key == "calibration_clock_offset_ms") c.calibration_clock_offset_ms = r.inRange(v, key, -1000.0, 1000.0);
     else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, gate_recovery, bin_length, fuse_config, jobs, sweeps, "
-                                  "sweep_trials, rsu_heights, speeds, smoother, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance, error_sources, rsu_calibration)");
+                                  "sweep_trials, rsu_heights, speeds, smoother, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance, ndt_covariance, error_sources, errors, rsu_calibration)");
   }
   if (c.delays.front() != 0.0 || c.losses.front() != 0.0)
     throwConfigError(source_name, -1, "delays/losses", "the first delay and the first loss must be 0: the ideal network is the reference");
@@ -82,7 +92,13 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
 }
 
 ExperimentConfig loadExperimentConfig(const std::string& path) {
-  return parseExperimentConfig(YamlReader::readFile(path, "experiment file"), path);
+  ExperimentConfig c = parseExperimentConfig(YamlReader::readFile(path, "experiment file"), path);
+  // Files the experiment names are found beside it, as a configuration's registry is.
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (!c.fuse_config.empty() && std::filesystem::path(c.fuse_config).is_relative()) c.fuse_config = (folder / c.fuse_config).string();
+  for (std::string& site : c.sites)
+    if (!builtinScenario(site) && std::filesystem::path(site).is_relative() && std::filesystem::exists(folder / site)) site = (folder / site).string();
+  return c;
 }
 
 std::string scenarioText(const std::string& site) {

@@ -8,6 +8,8 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <cstdlib>
+#include <tuple>
 
 #include "coloc/core/error.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
@@ -349,6 +351,67 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     writeFile(out_dir + "/attribution.csv", csv.str());
   }
 
+  // The filter beside NDT's own poses at their stamps: never worse than its best input? By speed (the
+  // main drives and the speed sweep's) and configuration, the sites pooled; per site in the CSV.
+  std::ostringstream ndt_md;
+  {
+    struct Pool {
+      double n = 0, ndt = 0, fused = 0, settled = 0, acc_n = 0, acc_ndt = 0, acc_fused = 0, acc_settled = 0;
+      void add(const replay::InputComparison& k) {
+        n += k.samples, ndt += k.input_mean * k.samples, fused += k.fused_mean * k.samples, settled += k.settled_mean * k.samples;
+        acc_n += k.accurate_samples, acc_ndt += k.accurate_input_mean * k.accurate_samples;
+        acc_fused += k.accurate_fused_mean * k.accurate_samples, acc_settled += k.accurate_settled_mean * k.accurate_samples;
+      }
+    };
+    std::map<std::tuple<double, std::string, std::string>, Pool> by;  // (speed, configuration, site or "")
+    double stretch = 0.0, below = 0.0;
+    for (const ExperimentRun& r : results.runs) {
+      if (r.ndt.samples == 0 || r.delay != 0.0 || r.loss != 0.0) continue;
+      double speed = 0.0;
+      if (r.variant.empty()) {
+        for (const SiteInfo& s : results.sites)
+          if (s.name == r.site) speed = s.cruise_speed;
+      } else if (r.variant.rfind("speed ", 0) == 0) {
+        speed = std::atof(r.variant.c_str() + 6);
+      } else {
+        continue;
+      }
+      const std::string configuration = r.lidar.empty() ? "NDT only" : "NDT + " + r.lidar;
+      by[{speed, configuration, ""}].add(r.ndt);
+      by[{speed, configuration, r.site}].add(r.ndt);
+      stretch = r.ndt.stretch_length, below = r.ndt.accurate_below;
+    }
+    if (!by.empty()) {
+      std::ostringstream csv;
+      csv << "speed_mps,configuration,site,scans,ndt_mean_m,output_mean_m,settled_mean_m,accurate_scans,accurate_ndt_mean_m,accurate_output_mean_m,"
+             "accurate_settled_mean_m\n";
+      ndt_md << "NDT's own pose per scan beside the filter at the same stamps, the sites and trials pooled: its output as given out "
+                "then (interpolated between ticks; it cannot know that scan's pose yet, which comes a sweep and a match later), and "
+                "its estimate for the stamp once that scan's pose is in (settled: the same information NDT's pose has, and what came "
+                "before). \"Where NDT is accurate\": the "
+             << fmt("%.0f m", stretch) << " stretches of road where NDT's mean error is below " << fmt("%.0f cm", 100 * below)
+             << " (chosen by stretch, not by scan, which would favour NDT by its luck on those scans).\n\n"
+             << "| speed | configuration | NDT per scan | output | settled | scans where NDT is accurate | NDT there | output there | settled there | settled / NDT there |\n"
+                "|---|---|---|---|---|---|---|---|---|---|\n";
+      for (const auto& [key, p] : by) {
+        const auto& [speed, configuration, site] = key;
+        csv << speed << "," << configuration << "," << (site.empty() ? "all" : site) << "," << p.n << "," << p.ndt / p.n << "," << p.fused / p.n << ","
+            << p.settled / p.n << "," << p.acc_n << "," << (p.acc_n ? p.acc_ndt / p.acc_n : 0.0) << "," << (p.acc_n ? p.acc_fused / p.acc_n : 0.0) << ","
+            << (p.acc_n ? p.acc_settled / p.acc_n : 0.0) << "\n";
+        if (!site.empty()) continue;
+        ndt_md << "| " << fmt("%.0f m/s", speed) << " | " << configuration << " | " << fmt("%.2f cm", 100 * p.ndt / p.n) << " | "
+               << fmt("%.2f cm", 100 * p.fused / p.n) << " | " << fmt("%.2f cm", 100 * p.settled / p.n) << " | "
+               << fmt("%.0f %%", 100 * p.acc_n / p.n) << " | ";
+        if (p.acc_n > 0)
+          ndt_md << fmt("%.2f cm", 100 * p.acc_ndt / p.acc_n) << " | " << fmt("%.2f cm", 100 * p.acc_fused / p.acc_n) << " | "
+                 << fmt("%.2f cm", 100 * p.acc_settled / p.acc_n) << " | " << fmt("%.2f", p.acc_settled / p.acc_ndt) << " |\n";
+        else
+          ndt_md << "- | - | - | - |\n";
+      }
+      writeFile(out_dir + "/ndt_vs_fused.csv", csv.str());
+    }
+  }
+
   // Tables II and III: the network grid, per LiDAR, over sites and trials.
   std::ostringstream network_md, network_csv;
   network_csv << "lidar,delay_s,loss,error_paper_m,error_mean_m,change_pct,fixes_lost\n";
@@ -534,6 +597,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
           "\"with neighbours\": another vehicle the RSU's background does not have (traffic, a car parked since the survey) within 10 m "
           "of the ego vehicle.\n\n"
        << attribution_md.str() << "\n";
+  if (!ndt_md.str().empty()) md << "## The filter against its best input: NDT's own poses\n\n" << ndt_md.str() << "\n";
   if (c.network)
     md << "## Tables II and III: network delay and packet loss\n\nMean over the sites and the first " << std::min(c.trials, c.network_trials)
        << " trial(s) of each; every cell replays the same drives.\n" << network_md.str() << "\n![network](network.svg)\n\n";
@@ -560,6 +624,15 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
       }
       md << " (the messages say 0.2 m/s and 0.1 rad/s).";
     }
+    if (!results.estimated_ndt_variance.empty()) {
+      md << " NDT's covariance, from its own poses on the same drive (the mean square error, x/y and yaw): ";
+      first = true;
+      for (const auto& [site, v] : results.estimated_ndt_variance) {
+        md << (first ? "" : ", ") << site << fmt(" %.1f cm", 100 * std::sqrt(v[0])) << fmt(" and %.2f deg", std::sqrt(v[1]) * 180.0 / M_PI);
+        first = false;
+      }
+      md << " (Autoware's fixed matrix says 15 cm and 1.4 deg).";
+    }
     md << "\n\n";
   }
   md << "## Run time\n\n"
@@ -568,7 +641,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
      << "(" << c.jobs << " side by side).\n\n"
      << "## Files\n\n"
-     << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`, `fix_error_by_distance.csv`, `attribution.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
+     << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`, `fix_error_by_distance.csv`, `attribution.csv`, `ndt_vs_fused.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
      << "- `error_along_road.csv`: minimum error per bin along the road, per site, trial and configuration (figures 4 and 5)\n"
      << "- `recordings/SITE/trial_N/`: each drive as a rosbag2 log with its map and fuse configuration (`coloc fuse` replays it), the "
         "RSU fixes, every RSU frame's outcome (`rsu_frames.csv`) and, for trial 0, what each perception step buys (`rsu_perception.svg`)\n";

@@ -308,7 +308,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     const sim::VehicleState seen = drive.at(capture);
     scene.place(capture, nullptr);
     const auto c0 = Clock::now();
-    const auto sweep = sim::scanSweep(roof, scene.caster(), [&](double dt) { return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height); }, rng);
+    // The LiDAR as mounted, which its recorded extrinsic (yaw 0) misses by errors.lidar_mount_yaw.
+    const auto sweep = sim::scanSweep(roof, scene.caster(), [&](double dt) {
+      return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height) * Eigen::AngleAxisd(errors.lidar_mount_yaw, Eigen::Vector3d::UnitZ());
+    }, rng);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
     const io::Bytes b = io::encodePointCloud2(toPointCloud2(sweep, at(t)));

@@ -62,6 +62,26 @@ TEST(Pipeline, ALateFixGivesTheSameEstimateAsAnOnTimeOne) {
   EXPECT_NEAR(on_time.pose_covariance(0, 0), late.pose_covariance(0, 0), 1e-12);
 }
 
+TEST(Pipeline, ASettledEstimateIsTheFiltersViewOfAPosesStampOnceThatPoseIsIn) {
+  // The fix 50 ms late: the tick's output at its stamp cannot know it, the settled estimate does.
+  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}});
+  const fusion::SourceId odom = pipe.addTwistSource("odom");
+  std::vector<std::pair<std::string, fusion::Estimate>> settled;
+  pipe.onPoseSettled([&](const std::string& source, const fusion::Estimate& e) { settled.emplace_back(source, e); });
+  pipe.pushInitialPose(planarPose(kStart, 0.0, 0.0, 0.0), kStart);
+  for (int k = 1; k <= 100; ++k) pipe.pushTwist(odom, twist(kStart + k * kTick, 5.0, 0.0), kStart + k * kTick + 2'000'000);
+  const Stamp fix_stamp = kStart + 30 * kTick;
+  pipe.pushFix(fixAt(fix_stamp, 3.0 + 0.05, 0.02), fix_stamp + 50'000'000);
+  pipe.runUntil(kStart + 100 * kTick);
+  ASSERT_EQ(settled.size(), 1u);
+  EXPECT_EQ(settled[0].first, "/rsu/rsu_a/fix");  // the source, named by its topic
+  EXPECT_EQ(settled[0].second.stamp, fix_stamp);
+  // The fix (5 cm ahead, 2 cm left) pulled the estimate at its stamp towards it.
+  EXPECT_GT(settled[0].second.pose.position.x(), 3.0 + 0.005);
+  EXPECT_GT(settled[0].second.pose.position.y(), 0.002);
+  EXPECT_LT(settled[0].second.pose.position.x(), 3.0 + 0.05 + 1e-9);
+}
+
 TEST(Pipeline, FixesPassTheRegistrysChecksBeforeReachingTheFilter) {
   Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}});
   std::vector<std::string> rejections;

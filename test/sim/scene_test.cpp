@@ -71,12 +71,16 @@ TEST(Scenario, UnstatedRsuSurveyAndClockErrorsAreDrawnOncePerInstallationFromThe
   EXPECT_EQ(ideal.rsus[0].clock_offset, 0.0);
   EXPECT_EQ(ideal.rsus[1].survey_error, Eigen::Vector3d(0.1, 0, 0));
   EXPECT_FALSE(ideal.errors.detailed_vehicle);
+  EXPECT_EQ(ideal.errors.lidar_mount_yaw, 0.0);
+  EXPECT_GT(s.errors.lidar_mount_yaw, 0.0);  // a real car's LiDAR is mounted a little off its calibration
   // The errors section, in the file's units, and its mistakes.
   const Scenario e = parseScenario(std::string(kRoute) + "errors: {preset: ideal, survey_yaw_sd_deg: 0.5, clock_offset_sd_ms: 10, dropout: 0.1}\n", "s.yaml");
   EXPECT_NEAR(e.errors.survey_yaw_sd, 0.5 * M_PI / 180.0, 1e-15);
   EXPECT_DOUBLE_EQ(e.errors.clock_offset_sd, 0.010);
   EXPECT_DOUBLE_EQ(e.errors.dropout, 0.1);
   EXPECT_EQ(e.errors.survey_position_sd, 0.0);
+  EXPECT_NEAR(parseScenario(std::string(kRoute) + "errors: {lidar_mount_yaw_deg: -0.5}\n", "s.yaml").errors.lidar_mount_yaw, -0.5 * M_PI / 180.0, 1e-15);
+  expectError(std::string(kRoute) + "errors: {lidar_mount_yaw_deg: 20}\n", "errors.lidar_mount_yaw_deg");
   expectError(std::string(kRoute) + "errors: {fog: 1}\n", "errors.fog: unknown key");
   expectError(std::string(kRoute) + "errors: {dropout: 1.5}\n", "errors.dropout");
   expectError(std::string(kRoute) + "errors: {vehicle_body: blob}\n", "errors.vehicle_body: expected one of detailed, boxes");

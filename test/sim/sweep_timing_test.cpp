@@ -45,6 +45,7 @@ route:
   pieces: [{length: 200}]
   speed: 10.0
 vehicle: {lidar: VLP-32C, lidar_height: 1.9}
+errors: {preset: ideal}  # an exact map: only the sweep's timing may show
 )";
 
 Eigen::Isometry3d lidarPose(const VehicleState& s) {

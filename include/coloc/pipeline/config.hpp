@@ -48,6 +48,10 @@ struct ReplayConfig {
   ClockMode clock = ClockMode::kAuto;
   /// Ground truth further than this from an output tick is not interpolated across.
   double ground_truth_max_gap = 0.2;  ///< s
+  /// Each pose input is compared with the fused estimate at its stamps, over all of them and over the
+  /// stretches of road this long where the input's mean error is below `input_accurate_below`.
+  double input_stretch_length = 10.0;  ///< m
+  double input_accurate_below = 0.02;  ///< m
 };
 
 /// Scan matching of a PointCloud2 topic against a map (`--map`).
@@ -71,6 +75,18 @@ struct PipelineSection {
   /// Learn the odometry's speed scale from NDT's poses and correct twists by it before the filter.
   bool speed_scale_estimation = true;
   double speed_scale_memory = 500.0;  ///< m of travel over which old comparisons fade
+  /// Learn the odometry's yaw-rate bias (gyro) from NDT's heading changes and remove it before the
+  /// filter. Off by default: it finds the twin's 0.002 rad/s within 0.0003, but with Autoware's loose
+  /// yaw-rate covariance the filter gains nothing, and on site B's bend the corrected heading tipped
+  /// NDT into following its own initial guess (2 cm -> 44 cm; README, "The filter against its best input").
+  bool yaw_rate_bias_estimation = false;
+  double yaw_rate_bias_memory = 60.0;  ///< s over which old comparisons fade
+  /// Learn the LiDAR's mounting yaw (NDT's heading minus the direction of travel) from NDT's own poses
+  /// and correct NDT's poses by it before the filter. Off by default: the filter's yaw-bias state
+  /// learns the same angle within about 10 s, and correcting it earlier changed the error by -1 to +18 %
+  /// on the twin (README); the learned angle is reported either way.
+  bool mount_yaw_estimation = false;
+  double mount_yaw_memory = 500.0;  ///< m of travel over which old comparisons fade
 };
 
 /// The Ceres smoother of recorded logs (coloc smooth, the experiment's smoother column). Its rate,

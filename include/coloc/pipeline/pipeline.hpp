@@ -53,6 +53,10 @@ struct PipelineReport {
   std::map<std::string, rsu_client::FixCounters> fixes;  ///< per RSU id
   double speed_scale = 1.0;                  ///< true speed per odometry speed, as learned from NDT (1 until known)
   double speed_scale_distance = 0.0;         ///< m of travel compared so far
+  double yaw_rate_bias = 0.0;                ///< rad/s, odometry minus true yaw rate, as learned from NDT (0 until known)
+  double yaw_rate_bias_time = 0.0;           ///< s compared so far
+  double mount_yaw = 0.0;                    ///< rad, NDT's heading minus the direction of travel (0 until known)
+  double mount_yaw_distance = 0.0;           ///< m compared so far
   std::uint64_t rejections = 0;              ///< every refusal, of any kind
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };
@@ -89,6 +93,10 @@ class Pipeline {
   void onEstimate(std::function<void(const fusion::Estimate&)> callback);
   /// Every pose measurement handed to the filter (NDT results, fixes, other sources), for plots.
   void onPoseInput(std::function<void(const std::string& source, const PoseMeasurement&)> callback);
+  /// For every pose the filter took, once its smoothing is over: the filter's estimate for the pose's
+  /// stamp from everything stamped up to it (the same information the source's own pose has), for
+  /// comparing the filter with each of its inputs.
+  void onPoseSettled(std::function<void(const std::string& source, const fusion::Estimate& at_stamp)> callback);
   /// Every twist handed to the filter, as handed (its speed scaled by what NDT taught so far) and as
   /// received, for smoothers.
   void onTwistInput(std::function<void(const std::string& source, const TwistMeasurement& handed, const TwistMeasurement& received)> callback);

@@ -37,6 +37,11 @@ struct ReplayResult {
   /// Each pose source's own measurements against ground truth at their stamps (NDT's per-scan error
   /// beside the fused error: a filter should never be worse than its best input).
   std::map<std::string, std::vector<ErrorSample>> input_errors;
+  /// The fused output at the same stamps (interpolated between ticks), the filter's settled estimate
+  /// for each of them (Pipeline::onPoseSettled), and the comparison of the three.
+  std::map<std::string, std::vector<ErrorSample>> fused_at_inputs, settled_at_inputs;
+  std::map<std::string, std::vector<io::TrajectoryPoint>> settled_poses;  ///< by source, as the pipeline gave them
+  std::map<std::string, InputComparison> input_comparison;
   std::vector<io::TrajectoryPoint> ground_truth;
   std::vector<ErrorSample> errors;                 ///< at ticks with ground truth
   ClockMode clock = ClockMode::kAuto;              ///< the mode used (never kAuto)
@@ -60,6 +65,10 @@ struct ReplayResult {
   std::vector<Matrix6d> fused_state_covariances;  ///< beside fused_states
   double speed_scale = 1.0;           ///< the odometry's speed scale learned from NDT
   double speed_scale_distance = 0.0;  ///< m of travel it was learned over
+  double yaw_rate_bias = 0.0;         ///< rad/s, the odometry's yaw-rate bias learned from NDT
+  double yaw_rate_bias_time = 0.0;    ///< s it was learned over
+  double mount_yaw = 0.0;             ///< rad, the LiDAR's mounting yaw learned from NDT
+  double mount_yaw_distance = 0.0;    ///< m it was learned over
 
   /// Everything that follows from the log and the config, as JSON (summary.json of `coloc fuse`): the
   /// same log and config give the same bytes. `log` is the name to print for the recording.

@@ -27,8 +27,21 @@ struct ErrorSources {
   /// to `dropout_at_max_range` at the datasheet's range.
   double dropout = 0.01;
   double dropout_at_max_range = 0.5;
+  /// The survey map's own error: the mapping vehicle places its scans with a GNSS/INS pose that errs
+  /// smoothly along the street (multipath and outages in street canyons), so the map is displaced from
+  /// the world by a few centimetres, differently every few tens of metres. NDT then localizes in the
+  /// map's frame, the RSU (RTK-surveyed) in the world's. Standard deviation per horizontal axis and of
+  /// yaw; the error varies over wavelengths of `map_error_length` to four times that along the route.
+  double map_position_sd = 0.05;  ///< m: mobile mapping in urban streets, 2-10 cm absolute
+  double map_yaw_sd = 0.05 * 3.14159265358979323846 / 180.0;  ///< rad
+  double map_error_length = 50.0;  ///< m
+  /// The vehicle LiDAR's yaw on the car minus what its extrinsic calibration (the recording's
+  /// lidar_pose) says: NDT then reports the car's heading off by this much while the car drives
+  /// straight on. 0.3 deg: KITTI's HDL-64E against its reference trajectory shows 0.2-0.6 deg between
+  /// the LiDAR's axis and the direction of travel after the published calibration.
+  double lidar_mount_yaw = 0.3 * 3.14159265358979323846 / 180.0;  ///< rad
 
-  /// The ideal twin: perfect survey and clocks, box-shaped car, 2 cm range noise, no dropouts.
+  /// The ideal twin: perfect surveys (RSU and map), clocks and LiDAR mounting, box-shaped car, 2 cm range noise, no dropouts.
   static ErrorSources ideal();
 };
 

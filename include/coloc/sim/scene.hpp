@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/core/yaml_reader.hpp"
 #include "coloc/sim/error_sources.hpp"
 #include "coloc/sim/mesh.hpp"
 #include "coloc/sim/traffic.hpp"
@@ -59,6 +60,10 @@ struct Scenario {
 /// Sets the error sources and draws what the RSUs do not state (survey error, clock offset) from them
 /// and the seed: one draw per RSU, the same for every drive of the scenario.
 void setErrorSources(Scenario& scenario, const ErrorSources& errors);
+
+/// An `errors:` section (a scenario's, or an experiment's for every site) on top of `base`: `preset`
+/// first, then each key given. Throws coloc::Error naming the reader's file, the line and the key.
+ErrorSources readErrorSources(const YamlReader& reader, const YAML::Node& node, const ErrorSources& base);
 
 /// Throws coloc::Error naming the file, line and key for unknown keys, unknown object types or LiDAR
 /// models, and values out of range.

@@ -1,7 +1,8 @@
 #pragma once
 // A point-cloud map made the way survey maps are made: a mapping vehicle drives the route, its LiDAR
 // samples the surfaces of the world as surveyed (range noise included), and the scans, placed with the
-// surveyor's exact poses, are merged and thinned on a voxel grid.
+// surveyor's poses (as exact as the scenario's error sources say: ErrorSources::map_*), are merged and
+// thinned on a voxel grid.
 #include <cstdint>
 #include <functional>
 

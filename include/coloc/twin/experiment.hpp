@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/replay/evaluation.hpp"
 #include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/smoother/smoother.hpp"
 #include "coloc/twin/experiment_config.hpp"
@@ -30,6 +31,8 @@ struct ExperimentRun {
   std::vector<double> error;   ///< m, planar
   std::uint64_t fixes_applied = 0, fixes_gated = 0, fixes_lost = 0;
   double replay_seconds = 0.0;
+  /// NDT's own poses beside the fused pose at their stamps (never worse than the best input?).
+  replay::InputComparison ndt;
 
   std::string label() const;  ///< "NDT only", "NDT + VLP-16", "NDT + VLP-16, 30 ms, 20 % loss"
 };
@@ -64,6 +67,7 @@ struct ExperimentTiming {
 struct SiteInfo {
   std::string name;
   double drive_length = 0.0;            ///< m
+  double cruise_speed = 0.0;            ///< m/s of the main drives
   std::vector<double> rsu_along;        ///< m along the drive where each RSU is nearest the road
 };
 
@@ -76,6 +80,8 @@ struct ExperimentResults {
   std::map<std::string, double> estimated_variance;
   /// Per site: the odometry's variance of speed ((m/s)^2) and yaw rate ((rad/s)^2) on that drive.
   std::map<std::string, Eigen::Vector2d> estimated_twist_variance;
+  /// Per site: NDT's mean square error per axis on that drive, x/y (m^2) and yaw (rad^2), when estimated.
+  std::map<std::string, Eigen::Vector2d> estimated_ndt_variance;
   std::vector<CalibrationResult> calibrations;
   /// Each RSU's survey and clock error as drawn and as its commissioning on the noise calibration
   /// drive found it (when `calibrate_rsus`).

@@ -32,10 +32,16 @@ struct ExperimentConfig {
   int network_trials = 3;
   /// The odometry's covariance as the filter gets it: `estimated` on the site's noise calibration drive
   /// (the twist's error against ground truth, after the speed scale the pipeline learns), or the
-  /// messages' own (the twin's say 0.2 m/s and 0.1 rad/s, Autoware's defaults). The messages' by
-  /// default for now: trusted at 0.05 m/s and 0.005 rad/s, the odometry's 0.002 rad/s gyro bias, for
-  /// which the filter has no state, turns NDT only from 4 cm into 10-12 cm (README).
+  /// messages' own (the twin's say 0.2 m/s and 0.1 rad/s, Autoware's defaults).
   bool twist_covariance_estimated = false;
+  /// NDT's covariance as the filter gets it: `estimated` on the site's noise calibration drive (the
+  /// mean square of NDT's own per-scan error against ground truth for x/y, yaw's variance about its
+  /// mean; z, roll and pitch keep Autoware's), or `published`, Autoware's fixed 0.0225 m^2 (15 cm) that
+  /// the paper uses. The published ones by default: trusted as measured (either or both), NDT on site B's
+  /// bend, started from the filter's prediction where the map constrains it weakly, confirms its own
+  /// initial guess and filter and NDT drift off together (2 cm -> 0.1-5 m; README, "The filter against
+  /// its best input"). NDT's results depend on the filter; a fixed covariance cannot say so.
+  bool ndt_covariance_estimated = false;
   /// Estimated by default: with the fixes carried to their tick (fusion.pose_time_alignment) the
   /// filter can trust them as much as they deserve; Table I shows the paper's figures beside it.
   RsuCovariance rsu_covariance = RsuCovariance::kEstimated;
@@ -61,6 +67,9 @@ struct ExperimentConfig {
   /// The road's error sources (sim/error_sources.hpp): `real` (each site's own, the published figures
   /// by default: RSU survey and clock, a real car's shape, range-dependent noise, dropouts) or `ideal`.
   bool ideal_twin = false;
+  /// An `errors:` section applied to every site on top of its own error sources (the keys of a
+  /// scenario's `errors:`, e.g. `{map_position_sd: 0}`), as YAML text; empty: none.
+  std::string errors;
   /// Calibrate every RSU (survey and clock, `coloc smooth --calibrate-rsus`) on its site's noise
   /// calibration drive and replay the evaluated drives with the calibrated registry, as a deployment
   /// would after commissioning; the fixes' variance is then measured after the calibration.
