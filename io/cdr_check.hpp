@@ -47,7 +47,5 @@ class CdrChecker {
   bool big_endian_;
 };
 
-/// True if `text` is well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
-bool isValidUtf8(const char* text, std::size_t size);
 
 }  // namespace coloc::io::detail

@@ -15,6 +15,7 @@
 #include "TwistWithCovarianceStamped.h"
 #include "cdr_codec.hpp"
 #include "coloc/core/error.hpp"
+#include "coloc/core/utf8.hpp"
 
 namespace coloc::io {
 namespace {
@@ -161,7 +162,7 @@ void checkEncodableString(const std::string& text, const char* field, std::strin
   if (text.find('\0') != std::string::npos) {
     detail::throwCodecError(type, std::string(field) + " contains a NUL byte");
   }
-  if (!detail::isValidUtf8(text.data(), text.size())) {
+  if (!isValidUtf8(text.data(), text.size())) {
     detail::throwCodecError(type, std::string(field) + " is not valid UTF-8");
   }
 }

@@ -143,6 +143,12 @@ rsu_client::RsuFix fixFromMessage(const io::StampedPose& message, const std::str
   fix.y = message.measurement.pose.position.y();
   const double yaw_variance = message.measurement.covariance(5, 5);
   if (std::isfinite(yaw_variance) && yaw_variance > 0.0) fix.yaw = rollPitchYaw(message.measurement.pose.orientation)[2];
+  // The decoder has refused a nanosec field of 1e9 or more already; the stamp's own is what was sent.
+  rsu_client::SentFields sent;
+  sent.frame_id = message.header.frame_id;
+  sent.covariance = message.measurement.covariance;
+  sent.nanosec = static_cast<std::uint32_t>(((message.measurement.stamp % kNanosPerSecond) + kNanosPerSecond) % kNanosPerSecond);
+  fix.sent = std::move(sent);
   return fix;
 }
 

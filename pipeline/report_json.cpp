@@ -34,9 +34,11 @@ std::string ndtJson(const ndt::NdtPoseSourceCounters& n, const ndt::DynamicMapSt
 
 std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes) {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
-  for (const auto& [id, c] : fixes)
-    j[id] = {{"received", c.received},       {"accepted", c.accepted}, {"unknown_rsu", c.unknown_rsu}, {"non_finite", c.non_finite},
-             {"out_of_coverage", c.out_of_coverage}, {"stale", c.stale}, {"from_future", c.from_future}, {"duplicate", c.duplicate}};
+  for (const auto& [id, c] : fixes) {
+    nlohmann::ordered_json o = {{"received", c.received}, {"accepted", c.accepted}};
+    for (const auto& [reason, count] : rsu_client::refusals(c)) o[reason] = count;
+    j[id] = std::move(o);
+  }
   return j.dump();
 }
 

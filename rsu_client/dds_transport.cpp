@@ -17,6 +17,7 @@
 
 #include "PoseWithCovarianceStampedPubSubTypes.h"
 #include "VehicleDimensionsPubSubTypes.h"
+#include "guarded_type.hpp"
 #include "coloc/core/error.hpp"
 #include "coloc/core/types.hpp"
 #include "dds_participant.hpp"
@@ -82,7 +83,9 @@ bool waitFor(const std::atomic<int>& matched, int count, std::chrono::millisecon
 // ---- fixes -------------------------------------------------------------------------------------
 
 struct FixSubscriber::Impl : public dds::DataReaderListener {
-  dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
+  AtomicSampleCounters counters;
+  std::function<void(const std::string&)> on_refused;
+  dds::TypeSupport type{new GuardedType<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>("an RSU fix topic", &counters, &on_refused)};
   std::vector<std::pair<dds::DataReader*, std::string>> readers;  ///< reader and its RSU id
   Callback callback;
   std::atomic<int> matched{0};
@@ -107,6 +110,12 @@ struct FixSubscriber::Impl : public dds::DataReaderListener {
         const auto& q = msg.pose().pose().orientation();
         fix.yaw = rollPitchYaw(Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()))[2];
       }
+      // What the message said beside the position, for the checker to hold against the registry.
+      SentFields sent;
+      sent.frame_id = msg.header().frame_id();
+      sent.nanosec = msg.header().stamp().nanosec();
+      for (int i = 0; i < 36; ++i) sent.covariance(i / 6, i % 6) = msg.pose().covariance()[i];
+      fix.sent = std::move(sent);
       callback(fix, received);
     }
   }
@@ -116,9 +125,11 @@ struct FixSubscriber::Impl : public dds::DataReaderListener {
   OwnedParticipant participant;  // last member: deleted first
 };
 
-FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback)
+FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback,
+                             std::function<void(const std::string&)> on_refused)
     : impl_(std::make_unique<Impl>()) {
   impl_->callback = std::move(callback);
+  impl_->on_refused = std::move(on_refused);
   impl_->participant = createParticipant(config);
   dds::Subscriber* subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (!subscriber) throw Error("DDS: cannot create a subscriber");
@@ -135,6 +146,7 @@ FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::str
 
 FixSubscriber::~FixSubscriber() = default;
 int FixSubscriber::matchedPublishers() const { return impl_->matched.load(); }
+SampleCounters FixSubscriber::sampleCounters() const { return impl_->counters.snapshot(); }
 
 struct FixPublisher::Impl {
   dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
@@ -209,7 +221,9 @@ bool DimensionsPublisher::waitForSubscribers(int count, std::chrono::millisecond
 }
 
 struct DimensionsSubscriber::Impl : public dds::DataReaderListener {
-  dds::TypeSupport type{new coloc_msgs::msg::VehicleDimensionsPubSubType()};
+  AtomicSampleCounters counters;
+  std::function<void(const std::string&)> on_refused;
+  dds::TypeSupport type{new GuardedType<coloc_msgs::msg::VehicleDimensionsPubSubType>(ddsTopicName(kVehicleDimensionsTopic), &counters, &on_refused)};
   Callback callback;
   std::atomic<int> matched{0};
 
@@ -227,8 +241,10 @@ struct DimensionsSubscriber::Impl : public dds::DataReaderListener {
   OwnedParticipant participant;  // last member: deleted first
 };
 
-DimensionsSubscriber::DimensionsSubscriber(const DdsConfig& config, Callback callback) : impl_(std::make_unique<Impl>()) {
+DimensionsSubscriber::DimensionsSubscriber(const DdsConfig& config, Callback callback, std::function<void(const std::string&)> on_refused)
+    : impl_(std::make_unique<Impl>()) {
   impl_->callback = std::move(callback);
+  impl_->on_refused = std::move(on_refused);
   impl_->participant = createParticipant(config);
   dds::Subscriber* subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   dds::Topic* topic = topicFor(impl_->participant, kVehicleDimensionsTopic, impl_->type);
@@ -238,5 +254,6 @@ DimensionsSubscriber::DimensionsSubscriber(const DdsConfig& config, Callback cal
 
 DimensionsSubscriber::~DimensionsSubscriber() = default;
 int DimensionsSubscriber::matchedPublishers() const { return impl_->matched.load(); }
+SampleCounters DimensionsSubscriber::sampleCounters() const { return impl_->counters.snapshot(); }
 
 }  // namespace coloc::rsu_client

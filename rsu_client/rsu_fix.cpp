@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <sstream>
 
+#include "coloc/core/utf8.hpp"
+
 namespace coloc::rsu_client {
 
 const char* toString(FixRejection reason) {
@@ -17,8 +19,18 @@ const char* toString(FixRejection reason) {
     case FixRejection::kStale: return "stale";
     case FixRejection::kFromFuture: return "from_future";
     case FixRejection::kDuplicate: return "duplicate";
+    case FixRejection::kWrongFrame: return "wrong_frame";
+    case FixRejection::kBadCovariance: return "bad_covariance";
+    case FixRejection::kBadStamp: return "bad_stamp";
   }
   return "?";
+}
+
+std::vector<std::pair<const char*, std::uint64_t>> refusals(const FixCounters& c) {
+  using R = FixRejection;
+  return {{toString(R::kUnknownRsu), c.unknown_rsu},   {toString(R::kNonFinite), c.non_finite},     {toString(R::kOutOfCoverage), c.out_of_coverage},
+          {toString(R::kStale), c.stale},              {toString(R::kFromFuture), c.from_future},   {toString(R::kDuplicate), c.duplicate},
+          {toString(R::kWrongFrame), c.wrong_frame},   {toString(R::kBadCovariance), c.bad_covariance}, {toString(R::kBadStamp), c.bad_stamp}};
 }
 
 FixChecker::FixChecker(RsuRegistry registry, FixCheckConfig config) : registry_(std::move(registry)), config_(config) {}
@@ -60,7 +72,61 @@ FixVerdict FixChecker::check(const RsuFix& fix, Stamp now) {
   if (!rsu) return reject(FixRejection::kUnknownRsu, "no such RSU in the registry", c.unknown_rsu);
   if (!std::isfinite(fix.x) || !std::isfinite(fix.y) || (fix.yaw && !std::isfinite(*fix.yaw)))
     return reject(FixRejection::kNonFinite, "position or yaw is not finite", c.non_finite);
+  if (fix.sent)
+    if (FixVerdict v = checkSent(fix, *rsu, c); !v.accepted()) return v;
   return checkKnown(rsu->calibration ? corrected(fix, *rsu) : fix, now, *rsu, c);
+}
+
+FixVerdict FixChecker::checkSent(const RsuFix& fix, const RsuInfo& rsu, FixCounters& c) const {
+  const SentFields& sent = *fix.sent;
+  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) { return rejected(fix, reason, why, counter); };
+  if (sent.nanosec >= 1000000000u)
+    return reject(FixRejection::kBadStamp, "header.stamp.nanosec " + std::to_string(sent.nanosec) + " is not below 1e9", c.bad_stamp);
+  // The frame name is checked for shape before it is quoted: it may be anything a sender wrote.
+  const std::string& frame = sent.frame_id;
+  if (frame.size() > kMaxFrameIdBytes)
+    return reject(FixRejection::kWrongFrame, "frame_id of " + std::to_string(frame.size()) + " bytes (at most " + std::to_string(kMaxFrameIdBytes) + ")",
+                  c.wrong_frame);
+  if (!isValidUtf8(frame.data(), frame.size()) || frame.find('\0') != std::string::npos)
+    return reject(FixRejection::kWrongFrame, "frame_id is not UTF-8 text", c.wrong_frame);
+  if (frame != registry_.mapFrame())
+    return reject(FixRejection::kWrongFrame, "frame '" + frame + "', the registry's map frame is '" + registry_.mapFrame() + "'", c.wrong_frame);
+  // The covariance: each entry finite or +inf (+inf: not measured), the matrix symmetric with a
+  // non-negative diagonal, and x and y measured, since a fix is nothing but x and y.
+  const Matrix6d& m = sent.covariance;
+  static const char* const kAxis[] = {"x", "y", "z", "roll", "pitch", "yaw"};
+  auto entry = [&](int i, int j) { return std::string("covariance[") + kAxis[i] + "," + kAxis[j] + "]"; };
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      if (std::isnan(m(i, j)) || m(i, j) == -kInfinity)
+        return reject(FixRejection::kBadCovariance, entry(i, j) + " is " + (std::isnan(m(i, j)) ? "NaN" : "-inf"), c.bad_covariance);
+  for (int i = 0; i < 6; ++i)
+    for (int j = i + 1; j < 6; ++j) {
+      const double a = m(i, j), b = m(j, i);
+      if (!(a == b || std::abs(a - b) <= 1e-9 * std::max({1.0, std::abs(a), std::abs(b)})))
+        return reject(FixRejection::kBadCovariance, "not symmetric: " + entry(i, j) + " " + std::to_string(a) + ", " + entry(j, i) + " " + std::to_string(b),
+                      c.bad_covariance);
+    }
+  for (int i = 0; i < 6; ++i)
+    if (m(i, i) < 0.0) return reject(FixRejection::kBadCovariance, entry(i, i) + " is negative (" + std::to_string(m(i, i)) + ")", c.bad_covariance);
+  for (int i = 0; i < 2; ++i)
+    if (!std::isfinite(m(i, i)) || m(i, i) <= 0.0)
+      return reject(FixRejection::kBadCovariance, entry(i, i) + (std::isfinite(m(i, i)) ? " is 0" : " is +inf (not measured)") + ": a fix must measure x and y",
+                    c.bad_covariance);
+  // The variance the RSU sent against the registry's: an RSU that disagrees is misconfigured (another
+  // LiDAR model, another placement) and its fixes are not trusted blindly. A calibrated variance is
+  // the vehicle's own measurement of this RSU and supersedes what it sends, by the registry's word.
+  if (!rsu.calibrated_variance) {
+    const double expected = registry_.variance(rsu);
+    for (int i = 0; i < 2; ++i)
+      if (std::abs(m(i, i) - expected) > 1e-6 * expected) {
+        std::ostringstream why;
+        why << entry(i, i) << " " << m(i, i) << " disagrees with the registry's " << expected << " for its " << rsu.lidar.name << " ("
+            << (registry_.placement() == CovariancePlacement::kPublished ? "published" : "standard_deviation") << " placement)";
+        return reject(FixRejection::kBadCovariance, why.str(), c.bad_covariance);
+      }
+  }
+  return {};
 }
 
 FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& known, FixCounters& c) {

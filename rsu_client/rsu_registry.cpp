@@ -97,6 +97,11 @@ RsuRegistry RsuRegistry::parse(const std::string& yaml_text, const std::string& 
       registry.placement_ = r.choice(entry.second, key, {"published", "standard_deviation"}) == "published"
                                 ? CovariancePlacement::kPublished
                                 : CovariancePlacement::kStandardDeviation;
+    } else if (key == "map_frame") {
+      registry.map_frame_ = r.text(entry.second, key);
+      bool plain = !registry.map_frame_.empty() && registry.map_frame_.size() <= 256;
+      for (char c : registry.map_frame_) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/' || c == '-' || c == '.');
+      if (!plain) r.fail(entry.second, key, "'" + registry.map_frame_ + "': a frame name of 1-256 letters, digits, _ / - .");
     } else if (key == "rsus") {
       if (!entry.second.IsSequence()) r.fail(entry.second, key, "expected a list of roadside units");
       for (std::size_t i = 0; i < entry.second.size(); ++i) {
@@ -105,7 +110,7 @@ RsuRegistry RsuRegistry::parse(const std::string& yaml_text, const std::string& 
         registry.rsus_.push_back(std::move(rsu));
       }
     } else {
-      r.fail(entry.first, key, "unknown key (covariance_placement, rsus)");
+      r.fail(entry.first, key, "unknown key (covariance_placement, map_frame, rsus)");
     }
   }
   return registry;
@@ -115,10 +120,11 @@ RsuRegistry RsuRegistry::load(const std::string& path) {
   return parse(YamlReader::readFile(path, "RSU registry"), path);
 }
 
-RsuRegistry::RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement) {
+RsuRegistry::RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement, const std::string& map_frame) {
   RsuRegistry probe;
   probe.rsus_ = rsus;
   probe.placement_ = placement;
+  probe.map_frame_ = map_frame;
   // Through the file format, so that an entry made in code passes exactly the checks a file does.
   *this = parse(probe.toYaml(), "(RSU registry made in code)");
 }
@@ -135,6 +141,7 @@ std::string RsuRegistry::toYaml() const {
   std::ostringstream out;
   out << "# Roadside units the vehicle accepts fixes from (coloc RSU registry). Positions are in the map frame.\n"
       << "covariance_placement: " << (placement_ == CovariancePlacement::kPublished ? "published" : "standard_deviation") << "\n"
+      << "map_frame: \"" << map_frame_ << "\"\n"
       << "rsus:" << (rsus_.empty() ? " []" : "") << "\n";
   for (const RsuInfo& r : rsus_) {
     out << "  - id: " << r.id << "\n"

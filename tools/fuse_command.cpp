@@ -47,12 +47,11 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 (unsigned long long)c.from_future, (unsigned long long)c.invalid, (unsigned long long)c.not_initialized,
                 (unsigned long long)c.pending);
   }
-  for (const auto& [id, c] : r.fixes)
-    std::printf("  RSU %s: %llu fixes received, %llu accepted; refused: %llu unknown RSU, %llu not finite, %llu out of coverage, "
-                "%llu stale, %llu from the future, %llu duplicate\n",
-                id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted, (unsigned long long)c.unknown_rsu,
-                (unsigned long long)c.non_finite, (unsigned long long)c.out_of_coverage, (unsigned long long)c.stale,
-                (unsigned long long)c.from_future, (unsigned long long)c.duplicate);
+  for (const auto& [id, c] : r.fixes) {
+    std::printf("  RSU %s: %llu fixes received, %llu accepted; refused:", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted);
+    for (const auto& [reason, count] : rsu_client::refusals(c)) std::printf(" %s %llu", reason, (unsigned long long)count);
+    std::printf("\n");
+  }
   for (const TopicUse& t : r.topics)
     if (!t.first_error.empty()) std::printf("  first decode error: %s\n", t.first_error.c_str());
   if (r.ndt_used) {

@@ -78,6 +78,10 @@ void addRsuListenCommand(CLI::App& app) {
       std::fflush(stdout);
       ++received;
       last_fix = std::chrono::steady_clock::now().time_since_epoch().count();
+    }, [&](const std::string& line) {
+      std::lock_guard<std::mutex> lock(mutex);
+      std::printf("%s\n", line.c_str());
+      std::fflush(stdout);
     });
     std::unique_ptr<rsu_client::DimensionsPublisher> dims;
     if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
@@ -101,12 +105,14 @@ void addRsuListenCommand(CLI::App& app) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     std::lock_guard<std::mutex> lock(mutex);
-    for (const auto& [id, c] : checker.counters())
-      std::printf("summary %s: received %llu accepted %llu unknown_rsu %llu non_finite %llu out_of_coverage %llu stale %llu "
-                  "from_future %llu duplicate %llu\n",
-                  id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted, (unsigned long long)c.unknown_rsu,
-                  (unsigned long long)c.non_finite, (unsigned long long)c.out_of_coverage, (unsigned long long)c.stale,
-                  (unsigned long long)c.from_future, (unsigned long long)c.duplicate);
+    for (const auto& [id, c] : checker.counters()) {
+      std::printf("summary %s: received %llu accepted %llu", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted);
+      for (const auto& [reason, count] : rsu_client::refusals(c)) std::printf(" %s %llu", reason, (unsigned long long)count);
+      std::printf("\n");
+    }
+    const rsu_client::SampleCounters refused = subscriber.sampleCounters();
+    std::printf("summary samples refused before decoding: wrong_encapsulation %llu undecodable %llu\n",
+                (unsigned long long)refused.wrong_encapsulation, (unsigned long long)refused.undecodable);
   });
 }
 
@@ -159,6 +165,10 @@ void addRsuPublishCommand(CLI::App& app) {
         std::lock_guard<std::mutex> lock(print);
         std::printf("dimensions station %u length %.3f width %.3f reference (%.3f, %.3f)\n", d.station_id, d.length, d.width,
                     d.reference_x, d.reference_y);
+        std::fflush(stdout);
+      }, [&](const std::string& line) {
+        std::lock_guard<std::mutex> lock(print);
+        std::printf("%s\n", line.c_str());
         std::fflush(stdout);
       });
     watchdog.disarm();

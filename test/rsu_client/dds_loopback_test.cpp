@@ -6,6 +6,7 @@
 #include <thread>
 #include <vector>
 
+#include "coloc/rsu_client/dds_node.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 
 namespace coloc::rsu_client {
@@ -47,6 +48,46 @@ TEST(DdsLoopback, FixesArriveOnTheirRsuTopicWithStampAndPosition) {
     EXPECT_EQ(received[i].x, 200.0 + i);
     EXPECT_FALSE(received[i].yaw.has_value());  // sent with +inf yaw variance: no yaw
   }
+}
+
+TEST(DdsLoopback, AnUndecodableFixSampleIsCountedAndTheListenerGoesOn) {
+  // Any participant may write on the topic: an XCDR2 sample (Fast DDS 2.9's generated code throws on
+  // it) and a truncated one, then a good fix.
+  std::mutex mutex;
+  std::vector<RsuFix> received;
+  std::vector<std::string> refused;
+  FixSubscriber subscriber(
+      testConfig(73), {"rsu_a"},
+      [&](const RsuFix& fix, Stamp) {
+        std::lock_guard<std::mutex> lock(mutex);
+        received.push_back(fix);
+      },
+      [&](const std::string& line) {
+        std::lock_guard<std::mutex> lock(mutex);
+        refused.push_back(line);
+      });
+  DdsNode intruder(testConfig(73));
+  TopicQos qos;
+  qos.reliable = true;
+  DdsNode::Writer raw = intruder.advertise(fixTopic("rsu_a"), "geometry_msgs/msg/PoseWithCovarianceStamped", qos);
+  ASSERT_TRUE(waitUntil([&] { return raw.matchedReaders() >= 1; }, std::chrono::seconds(10)));
+  std::vector<std::uint8_t> xcdr2(64, 0);
+  xcdr2[1] = 0x07;
+  ASSERT_TRUE(raw.write(xcdr2));
+  ASSERT_TRUE(raw.write(std::vector<std::uint8_t>{0x00, 0x01, 0x00, 0x00, 0x10, 0x00}));
+  ASSERT_TRUE(waitUntil([&] { const SampleCounters c = subscriber.sampleCounters(); return c.wrong_encapsulation + c.undecodable >= 2; },
+                        std::chrono::seconds(10)));
+  FixPublisher publisher(testConfig(73), "rsu_a");
+  ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
+  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt}, 0.00681);
+  ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 1; }, std::chrono::seconds(10)));
+  const SampleCounters c = subscriber.sampleCounters();
+  EXPECT_EQ(c.wrong_encapsulation, 1u);
+  EXPECT_EQ(c.undecodable, 1u);
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_EQ(received[0].x, 12.0);
+  ASSERT_EQ(refused.size(), 2u);
+  EXPECT_NE(refused[0].find("encapsulation 0x0007"), std::string::npos) << refused[0];
 }
 
 TEST(DdsLoopback, VehicleDimensionsReachTheRsu) {

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <vector>
 
 #include "coloc/fusion/localizer.hpp"
 #include "coloc/rsu_client/rsu_fix.hpp"
@@ -57,6 +59,72 @@ TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
   EXPECT_EQ(a.duplicate, 1u);
   EXPECT_EQ(a.accepted, 1u);
   EXPECT_EQ(c.counters().at("rsu_z").unknown_rsu, 1u);
+}
+
+// A fix as a message carries it: map frame, the registry's VLP-16 variance on x and y, +inf elsewhere.
+RsuFix sentFix(Stamp stamp, double x) {
+  RsuFix fix{stamp, "rsu_a", x, 0.0, std::nullopt};
+  SentFields sent;
+  sent.frame_id = "map";
+  sent.nanosec = static_cast<std::uint32_t>(stamp % kNanosPerSecond);
+  sent.covariance.diagonal() << 0.01486, 0.01486, kInfinity, kInfinity, kInfinity, kInfinity;
+  fix.sent = sent;
+  return fix;
+}
+
+TEST(FixChecker, AMessagesFrameCovarianceAndStampFieldAreHeldAgainstTheRegistry) {
+  FixChecker c = checker();
+  ASSERT_TRUE(c.check(sentFix(kNow - 1000, 101), kNow).accepted());
+  struct Case {
+    const char* what;
+    std::function<void(SentFields&)> spoil;
+    FixRejection reason;
+    const char* says;
+  };
+  const double nan = std::nan("");
+  const std::vector<Case> cases = {
+      {"frame odom", [](SentFields& s) { s.frame_id = "odom"; }, FixRejection::kWrongFrame, "frame 'odom'"},
+      {"empty frame", [](SentFields& s) { s.frame_id.clear(); }, FixRejection::kWrongFrame, "frame ''"},
+      {"frame not UTF-8", [](SentFields& s) { s.frame_id = "ma\xC3\x28"; }, FixRejection::kWrongFrame, "not UTF-8"},
+      {"frame of 1 MiB", [](SentFields& s) { s.frame_id.assign(1 << 20, 'm'); }, FixRejection::kWrongFrame, "1048576 bytes"},
+      {"nanosec 1e9", [](SentFields& s) { s.nanosec = 1000000000u; }, FixRejection::kBadStamp, "nanosec 1000000000"},
+      {"NaN variance", [&](SentFields& s) { s.covariance(0, 0) = nan; }, FixRejection::kBadCovariance, "covariance[x,x] is NaN"},
+      {"NaN off-diagonal", [&](SentFields& s) { s.covariance(2, 4) = nan; }, FixRejection::kBadCovariance, "covariance[z,pitch] is NaN"},
+      {"-inf", [](SentFields& s) { s.covariance(5, 5) = -kInfinity; }, FixRejection::kBadCovariance, "is -inf"},
+      {"negative", [](SentFields& s) { s.covariance(1, 1) = -0.01486; }, FixRejection::kBadCovariance, "covariance[y,y] is negative"},
+      {"asymmetric", [](SentFields& s) { s.covariance(0, 1) = 0.001; }, FixRejection::kBadCovariance, "not symmetric"},
+      {"x not measured", [](SentFields& s) { s.covariance(0, 0) = kInfinity; }, FixRejection::kBadCovariance, "+inf (not measured)"},
+      {"y zero", [](SentFields& s) { s.covariance(1, 1) = 0.0; }, FixRejection::kBadCovariance, "covariance[y,y] is 0"},
+      {"another variance", [](SentFields& s) { s.covariance(0, 0) = s.covariance(1, 1) = 0.00681; }, FixRejection::kBadCovariance,
+       "disagrees with the registry's 0.01486"},
+  };
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    RsuFix fix = sentFix(kNow - 2000 - static_cast<Stamp>(k), 101);
+    cases[k].spoil(*fix.sent);
+    const FixVerdict v = c.check(fix, kNow);
+    EXPECT_EQ(v.rejection, cases[k].reason) << cases[k].what << ": " << v.detail;
+    EXPECT_NE(v.detail.find(cases[k].says), std::string::npos) << cases[k].what << ": " << v.detail;
+    EXPECT_LT(v.detail.size(), 400u) << cases[k].what << ": a refusal quotes no megabyte";
+  }
+  const FixCounters& a = c.counters().at("rsu_a");
+  EXPECT_EQ(a.wrong_frame, 4u);
+  EXPECT_EQ(a.bad_stamp, 1u);
+  EXPECT_EQ(a.bad_covariance, 8u);
+  EXPECT_EQ(a.accepted, 1u);
+  EXPECT_EQ(a.received, 1u + cases.size());
+}
+
+TEST(FixChecker, ARegistryFrameOtherThanMapAndACalibratedVarianceAreHonoured) {
+  FixChecker c(RsuRegistry::parse("map_frame: earth\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n",
+                                  "test"));
+  RsuFix fix = sentFix(kNow - 1000, 101);
+  EXPECT_EQ(c.check(fix, kNow).rejection, FixRejection::kWrongFrame);
+  fix.sent->frame_id = "earth";
+  fix.stamp -= 1;
+  // The vehicle's own measurement of this RSU supersedes the variance the RSU sends.
+  const FixVerdict v = c.check(fix, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_EQ(v.measurement.covariance(0, 0), 0.0004);
 }
 
 TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {

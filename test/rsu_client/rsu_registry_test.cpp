@@ -58,6 +58,15 @@ TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
               "rsus[0].calibrated_variance: must be a finite number > 0");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: .nan}\n", "rsus[0].calibrated_variance: must not be NaN");
   expectError("rsu:\n  - {}\n", "rsu: unknown key");
+  expectError("map_frame: \"\"\n", "map_frame: '': a frame name");
+  expectError("map_frame: \"a b\"\n", "map_frame: 'a b': a frame name");
+}
+
+TEST(RsuRegistry, MapFrameDefaultsToMapAndSurvivesTheFileFormat) {
+  EXPECT_EQ(RsuRegistry::parse("rsus: []\n", "test").mapFrame(), "map");
+  const RsuRegistry r = RsuRegistry::parse("map_frame: world/utm_54\nrsus: []\n", "test");
+  EXPECT_EQ(r.mapFrame(), "world/utm_54");
+  EXPECT_EQ(RsuRegistry::parse(r.toYaml(), "again").mapFrame(), "world/utm_54");
 }
 
 }  // namespace

@@ -53,16 +53,28 @@ struct VehicleDimensions {
 /// Nanoseconds since the Unix epoch on the system clock: the vehicle's "now" for received messages.
 Stamp systemNow();
 
+/// Samples a subscriber refused before they reached its callback, by reason. A bad sample is consumed
+/// and counted; the subscriber goes on.
+struct SampleCounters {
+  std::uint64_t wrong_encapsulation = 0;  ///< not plain CDR (XCDR2 and others)
+  std::uint64_t undecodable = 0;          ///< truncated, or not the topic's type
+};
+
 class FixSubscriber {
  public:
   /// Called on a DDS thread for every sample: the fix and its arrival time (systemNow()).
   using Callback = std::function<void(const RsuFix& fix, Stamp received)>;
   /// Subscribes to the fix topic of each RSU id. Throws coloc::Error if DDS refuses (bad security
   /// files, ...), naming the reason.
-  FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback);
+  /// `on_refused` (optional) is called on a DDS thread with one line naming the topic and the reason
+  /// for every sample refused before decoding (wrong encapsulation, undecodable).
+  FixSubscriber(const DdsConfig& config, const std::vector<std::string>& rsu_ids, Callback callback,
+                std::function<void(const std::string& line)> on_refused = {});
   ~FixSubscriber();
   /// Writers currently matched, over all RSU topics.
   int matchedPublishers() const;
+  /// Samples refused before the callback (counted; `on_refused` of the constructor got a line each).
+  SampleCounters sampleCounters() const;
 
  private:
   struct Impl;
@@ -98,9 +110,10 @@ class DimensionsPublisher {
 class DimensionsSubscriber {
  public:
   using Callback = std::function<void(const VehicleDimensions&)>;
-  DimensionsSubscriber(const DdsConfig& config, Callback callback);
+  DimensionsSubscriber(const DdsConfig& config, Callback callback, std::function<void(const std::string& line)> on_refused = {});
   ~DimensionsSubscriber();
   int matchedPublishers() const;
+  SampleCounters sampleCounters() const;
 
  private:
   struct Impl;

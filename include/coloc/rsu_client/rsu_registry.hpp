@@ -50,7 +50,7 @@ class RsuRegistry {
  public:
   RsuRegistry() = default;
   /// From entries made in code, checked as a file's would be (throws coloc::Error naming the entry).
-  RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement);
+  RsuRegistry(const std::vector<RsuInfo>& rsus, CovariancePlacement placement, const std::string& map_frame = "map");
   /// The registry as a file that `load` reads back to the same registry.
   /// Throws coloc::Error naming the file, line and key for unknown keys, unknown LiDAR models,
   /// duplicate ids and values out of range.
@@ -61,6 +61,8 @@ class RsuRegistry {
   const RsuInfo* find(const std::string& id) const;
   const std::vector<RsuInfo>& rsus() const { return rsus_; }
   CovariancePlacement placement() const { return placement_; }
+  /// The frame fixes are expressed in (`map_frame`, default "map"): a fix naming another is refused.
+  const std::string& mapFrame() const { return map_frame_; }
   /// The x/y variance a fix from this RSU carries: its calibrated variance, else the model's figure
   /// placed as the registry says.
   double variance(const RsuInfo& rsu) const;
@@ -68,6 +70,7 @@ class RsuRegistry {
  private:
   std::vector<RsuInfo> rsus_;
   CovariancePlacement placement_ = CovariancePlacement::kPublished;
+  std::string map_frame_ = "map";
 };
 
 }  // namespace coloc::rsu_client
