@@ -12,6 +12,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   libpcl-dev libembree-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  cyclonedds-dev cyclonedds-tools
 )
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done

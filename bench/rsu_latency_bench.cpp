@@ -65,6 +65,7 @@ int main() {
 
   rsu_client::DdsConfig dds;
   dds.domain = 73;
+  dds.loopback_only = true;  // measured on loopback: nothing leaves the machine
   rsu_client::FixSubscriber subscriber(dds, {"rsu_a"}, [&](const rsu_client::RsuFix& fix, Stamp now) {
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -83,7 +84,7 @@ int main() {
       std::lock_guard<std::mutex> lock(mutex);
       sent[stamp] = Clock::now();
     }
-    publisher.publish({stamp, "rsu_a", 10.0, 0.5, std::nullopt}, 0.00681);  // a vehicle standing in view
+    publisher.publish({stamp, "rsu_a", 10.0, 0.5, std::nullopt, std::nullopt}, 0.00681);  // a vehicle standing in view
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));

@@ -1,6 +1,7 @@
 // convert(): any readable bag to a rosbag2 sqlite3 directory or an MCAP file, message by message.
 #include <filesystem>
 #include <optional>
+#include <type_traits>
 
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_reader.hpp"
@@ -24,6 +25,10 @@ std::uint64_t copyMessages(BagReader& reader, Writer& writer) {
   while (reader.next(message)) {
     writer.write(message);
     ++count;
+  }
+  if constexpr (std::is_same_v<Writer, McapWriter>) {
+    for (const BagAttachment& a : reader.attachments()) writer.writeAttachment(a);
+    for (const BagMetadataRecord& m : reader.metadataRecords()) writer.writeMetadata(m);
   }
   writer.close();
   return count;
@@ -57,10 +62,12 @@ ConvertSummary convert(const std::string& input, const std::string& output, cons
   if (is_mcap) {
     mcap.emplace(McapWriter::create(output, options.mcap));
   } else {
-    sqlite.emplace(BagWriter::create(output));
+    sqlite.emplace(BagWriter::create(output, options.sqlite_compression));
   }
   try {
     summary.message_count = is_mcap ? copyMessages(reader, *mcap) : copyMessages(reader, *sqlite);
+    summary.attachments = reader.attachments().size();
+    summary.metadata_records = reader.metadataRecords().size();
   } catch (const Error& e) {
     mcap.reset();
     sqlite.reset();

@@ -3,11 +3,16 @@
 #include "coloc/io/bag_reader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 
+#include <stdlib.h>
+#include <unistd.h>
+
+#include "bag_compression.hpp"
 #include "bag_metadata.hpp"
 #include "coloc/core/error.hpp"
 #include "mcap_records.hpp"
@@ -56,10 +61,51 @@ bool splitOrderLess(const std::string& a, const std::string& b) {
   return ka != kb ? ka < kb : a < b;
 }
 
+enum class Compression { kNone, kFile, kMessage };
+
 struct BagLayout {
   Storage storage = Storage::kMcap;
   std::vector<std::string> files;
   std::vector<TopicInfo> metadata_topics;  // from metadata.yaml, to fill what old storage lacks
+  Compression compression = Compression::kNone;
+};
+
+/// A private directory under the system's temporary directory, removed with everything in it.
+class TemporaryDirectory {
+ public:
+  TemporaryDirectory() {
+    std::string pattern = (fs::temp_directory_path() / ("coloc-bag-" + std::to_string(::getpid()) + "-XXXXXX")).string();
+    if (::mkdtemp(pattern.data()) == nullptr) throw Error(pattern + ": cannot create a directory to decompress the bag into");
+    path_ = pattern;
+  }
+  ~TemporaryDirectory() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+/// MESSAGE mode: each message's bytes are a zstd frame, decompressed as they are read.
+class MessageDecompressing final : public detail::StorageReader {
+ public:
+  MessageDecompressing(std::unique_ptr<detail::StorageReader> inner, std::string path) : inner_(std::move(inner)), path_(std::move(path)) {}
+  const std::vector<TopicInfo>& topics() const override { return inner_->topics(); }
+  bool next(BagMessage& message) override {
+    if (!inner_->next(message)) return false;
+    message.data = detail::decompressZstdMessage(message.data.data(), message.data.size(),
+                                                 path_ + ": message " + std::to_string(read_++) + " on " + message.topic);
+    return true;
+  }
+
+ private:
+  std::unique_ptr<detail::StorageReader> inner_;
+  std::string path_;
+  std::uint64_t read_ = 0;
 };
 
 /// rosbag2 resolves relative_file_paths against the bag directory since metadata version 4, against
@@ -85,8 +131,13 @@ BagLayout layoutFromMetadata(const fs::path& directory, const std::string& metad
                 "' is not supported (sqlite3, mcap)");
   }
   if (!metadata.compression_format.empty()) {
-    throw Error(metadata_path + ": the bag is compressed (compression_format '" + metadata.compression_format +
-                "', mode '" + metadata.compression_mode + "'), which is not supported; decompress it first");
+    if (metadata.compression_format != "zstd")
+      throw Error(metadata_path + ": compression_format '" + metadata.compression_format + "' is not supported (zstd)");
+    std::string mode = metadata.compression_mode;
+    for (char& c : mode) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    if (mode == "FILE") layout.compression = Compression::kFile;
+    else if (mode == "MESSAGE") layout.compression = Compression::kMessage;
+    else throw Error(metadata_path + ": compression_mode '" + metadata.compression_mode + "' is not supported (FILE, MESSAGE)");
   }
   if (metadata.relative_file_paths.empty()) throw Error(metadata_path + ": relative_file_paths lists no storage file");
   for (const auto& listed : metadata.relative_file_paths) {
@@ -146,6 +197,7 @@ void mergeTopics(std::vector<TopicInfo>& merged, const std::vector<TopicInfo>& m
 }  // namespace
 
 struct BagReader::Impl {
+  std::optional<TemporaryDirectory> decompressed;  // FILE mode: the storage files, decompressed
   std::string path;
   std::string storage;
   std::vector<std::string> files;
@@ -154,6 +206,8 @@ struct BagReader::Impl {
   std::uint64_t message_count = 0;
   std::size_t current = 0;
   std::uint64_t next_index = 0;
+  std::vector<BagAttachment> attachments;
+  std::vector<BagMetadataRecord> metadata;
 };
 
 BagReader BagReader::open(const std::string& path) {
@@ -163,7 +217,20 @@ BagReader BagReader::open(const std::string& path) {
   impl->storage = storageName(layout.storage);
   impl->files = layout.files;
   for (const auto& file : layout.files) {
-    impl->readers.push_back(openStorage(layout.storage, file));
+    if (layout.compression == Compression::kFile) {
+      // A storage file must be seekable (sqlite3, MCAP's footer): each is decompressed to a temporary
+      // file that lives as long as the reader.
+      if (!impl->decompressed) impl->decompressed.emplace();
+      std::string name = fs::path(file).filename().string();
+      if (name.size() > 5 && name.compare(name.size() - 5, 5, ".zstd") == 0) name.resize(name.size() - 5);
+      const std::string plain = (impl->decompressed->path() / (std::to_string(impl->readers.size()) + "_" + name)).string();
+      detail::decompressZstdFile(file, plain);
+      impl->readers.push_back(openStorage(layout.storage, plain));
+    } else if (layout.compression == Compression::kMessage) {
+      impl->readers.push_back(std::make_unique<MessageDecompressing>(openStorage(layout.storage, file), file));
+    } else {
+      impl->readers.push_back(openStorage(layout.storage, file));
+    }
     mergeTopics(impl->topics, impl->readers.back()->topics());
   }
   for (auto& topic : impl->topics) {
@@ -186,6 +253,8 @@ const std::string& BagReader::storageIdentifier() const { return impl_->storage;
 const std::vector<std::string>& BagReader::files() const { return impl_->files; }
 const std::vector<TopicInfo>& BagReader::topics() const { return impl_->topics; }
 std::uint64_t BagReader::messageCount() const { return impl_->message_count; }
+const std::vector<BagAttachment>& BagReader::attachments() const { return impl_->attachments; }
+const std::vector<BagMetadataRecord>& BagReader::metadataRecords() const { return impl_->metadata; }
 
 bool BagReader::next(BagMessage& message) {
   while (impl_->current < impl_->readers.size()) {
@@ -193,6 +262,8 @@ bool BagReader::next(BagMessage& message) {
       message.index = impl_->next_index++;
       return true;
     }
+    for (BagAttachment& a : impl_->readers[impl_->current]->takeAttachments()) impl_->attachments.push_back(std::move(a));
+    for (BagMetadataRecord& m : impl_->readers[impl_->current]->takeMetadata()) impl_->metadata.push_back(std::move(m));
     impl_->readers[impl_->current++].reset();  // release the finished file's handle and buffers
   }
   return false;

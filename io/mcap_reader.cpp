@@ -60,6 +60,8 @@ class McapReader final : public StorageReader {
   explicit McapReader(const std::string& path);
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   bool next(BagMessage& message) override;
+  std::vector<BagAttachment> takeAttachments() override { return std::move(attachments_); }
+  std::vector<BagMetadataRecord> takeMetadata() override { return std::move(metadata_); }
 
  private:
   struct RecordHead {
@@ -98,6 +100,8 @@ class McapReader final : public StorageReader {
   std::map<std::uint16_t, ChannelRecord> channels_;
   std::vector<TopicInfo> topics_;
   std::map<std::uint16_t, std::size_t> topic_of_channel_;
+  std::vector<BagAttachment> attachments_;  // met in the data section, for conversion
+  std::vector<BagMetadataRecord> metadata_;
 
   std::uint64_t offset_ = 0;  // next top-level record
   bool done_ = false;
@@ -219,7 +223,7 @@ void McapReader::readSummary(const Footer& footer) {
   }
   summary.resize(static_cast<std::size_t>(footer_offset - footer.summary_start));
   const std::string where_prefix = path_ + ": summary record at byte offset";
-  std::vector<ChannelRecord> channels;
+  std::vector<std::pair<ChannelRecord, std::string>> channels;  // with where each was read
   std::optional<Statistics> statistics;
   for (std::size_t position = 0; position < summary.size();) {
     const std::size_t record_offset = position;
@@ -227,12 +231,20 @@ void McapReader::readSummary(const Footer& footer) {
     RecordCursor cursor(span.content, span.size,
                         where_prefix + " " + std::to_string(footer.summary_start + record_offset));
     if (span.opcode == kSchema) registerSchema(parseSchema(cursor));
-    if (span.opcode == kChannel) channels.push_back(parseChannel(cursor));
+    if (span.opcode == kChannel) channels.emplace_back(parseChannel(cursor), cursor.where());
     if (span.opcode == kStatistics) statistics = parseStatistics(cursor);
   }
+  // A summary may repeat channels without their schemas (valid MCAP: repeatSchemas false): the
+  // schemas are then only in the data section, and one scan of it finds both.
+  for (const auto& [channel, where] : channels)
+    if (channel.schema_id != 0 && schemas_.count(channel.schema_id) == 0) {
+      topics_.clear();
+      topic_of_channel_.clear();
+      return;
+    }
   // Channels after all schemas: the specification groups summary records by opcode but does not
   // order the groups.
-  for (const auto& channel : channels) registerChannel(channel, where_prefix);
+  for (const auto& [channel, where] : channels) registerChannel(channel, where);
   if (!statistics || statistics->channel_message_counts.empty()) {
     topics_.clear();  // no counts: the scan rebuilds topics with them
     topic_of_channel_.clear();
@@ -257,15 +269,19 @@ void McapReader::registerChannel(const ChannelRecord& channel, const std::string
   if (channel.schema_id != 0) {
     const auto schema = schemas_.find(channel.schema_id);
     if (schema == schemas_.end()) {
-      throw Error(where + ": channel " + std::to_string(channel.id) + " (" + channel.topic + ") refers to schema " +
+      throw Error(where + ": Channel " + std::to_string(channel.id) + " (" + channel.topic + ") refers to schema " +
                   std::to_string(channel.schema_id) + ", which no Schema record defines before it");
     }
     info.type = schema->second.name;
     info.message_definition = schema->second.data;
     info.message_definition_encoding = schema->second.encoding;
   }
-  const auto qos = channel.metadata.find("offered_qos_profiles");
-  if (qos != channel.metadata.end()) info.offered_qos_profiles = qos->second;
+  info.metadata = channel.metadata;
+  const auto qos = info.metadata.find("offered_qos_profiles");
+  if (qos != info.metadata.end()) {
+    info.offered_qos_profiles = qos->second;
+    info.metadata.erase(qos);
+  }
   for (std::size_t i = 0; i < topics_.size(); ++i) {
     if (topics_[i].name == info.name) {
       topic_of_channel_[channel.id] = i;
@@ -298,6 +314,8 @@ void McapReader::rewind() {
   std::vector<std::uint8_t>().swap(chunk_);
   std::vector<std::uint8_t>().swap(content_);
   chunk_position_ = 0;
+  attachments_.clear();
+  metadata_.clear();
 }
 
 bool McapReader::next(BagMessage& message) {
@@ -325,6 +343,14 @@ bool McapReader::next(BagMessage& message) {
         if (dispatch(head.opcode, cursor, message)) return true;
         break;
       }
+      case kAttachment:
+      case kMetadata: {
+        loadContent(head);
+        RecordCursor cursor(content_.data(), content_.size(), where(head));
+        if (head.opcode == kAttachment) attachments_.push_back(parseAttachment(cursor));
+        else metadata_.push_back(parseMetadata(cursor));
+        break;
+      }
       case kDataEnd:
         done_ = true;
         return false;
@@ -333,7 +359,7 @@ bool McapReader::next(BagMessage& message) {
         fail("unexpected " + opcodeName(head.opcode) + " record at byte offset " + std::to_string(head.offset) +
              " inside the data section");
       default:
-        break;  // indexes, attachments, metadata and extension records carry no messages
+        break;  // indexes and extension records carry no messages
     }
   }
 }
@@ -346,7 +372,7 @@ bool McapReader::dispatch(std::uint8_t opcode, RecordCursor& cursor, BagMessage&
       registerSchema(parseSchema(cursor));
       return false;
     case kChannel:
-      registerChannel(parseChannel(cursor), path_);
+      registerChannel(parseChannel(cursor), cursor.where());
       return false;
     default:
       return false;

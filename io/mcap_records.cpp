@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "coloc/core/error.hpp"
+#include "crc32.hpp"
 
 namespace coloc::io::detail::mcap {
 
@@ -155,6 +156,34 @@ Statistics parseStatistics(RecordCursor& c) {
   return s;
 }
 
+BagAttachment parseAttachment(RecordCursor& c) {
+  BagAttachment a;
+  const std::uint8_t* start = c.current();
+  const std::uint64_t log_time = c.u64("log_time"), create_time = c.u64("create_time");
+  if (log_time > static_cast<std::uint64_t>(INT64_MAX) || create_time > static_cast<std::uint64_t>(INT64_MAX))
+    c.fail("time stamp beyond the int64 nanosecond range");
+  a.log_time = static_cast<Stamp>(log_time);
+  a.create_time = static_cast<Stamp>(create_time);
+  a.name = c.string("name");
+  a.media_type = c.string("media_type");
+  const auto [p, n] = c.bytes64("data");
+  a.data.assign(p, p + n);
+  const std::size_t covered = static_cast<std::size_t>(c.current() - start);
+  const std::uint32_t stored = c.u32("crc");
+  if (stored != 0) {
+    const std::uint32_t computed = crc32(start, covered);
+    if (computed != stored) c.fail("attachment '" + a.name + "' CRC mismatch: the attachment is corrupt");
+  }
+  return a;
+}
+
+BagMetadataRecord parseMetadata(RecordCursor& c) {
+  BagMetadataRecord m;
+  m.name = c.string("name");
+  m.entries = c.stringMap("metadata");
+  return m;
+}
+
 Footer parseFooter(RecordCursor& c) {
   Footer f;
   f.summary_start = c.u64("summary_start");
@@ -223,6 +252,20 @@ std::vector<std::uint8_t> schemaContent(const SchemaRecord& schema) {
 std::vector<std::uint8_t> channelContent(const ChannelRecord& channel) {
   RecordBuilder b;
   b.u16(channel.id).u16(channel.schema_id).string(channel.topic).string(channel.message_encoding).stringMap(channel.metadata);
+  return b.content();
+}
+
+std::vector<std::uint8_t> attachmentContent(const BagAttachment& a) {
+  RecordBuilder b;
+  b.u64(static_cast<std::uint64_t>(a.log_time)).u64(static_cast<std::uint64_t>(a.create_time)).string(a.name).string(a.media_type);
+  b.u64(a.data.size()).bytes(a.data.data(), a.data.size());
+  b.u32(crc32(b.content().data(), b.content().size()));
+  return b.content();
+}
+
+std::vector<std::uint8_t> metadataContent(const BagMetadataRecord& m) {
+  RecordBuilder b;
+  b.string(m.name).stringMap(m.entries);
   return b.content();
 }
 

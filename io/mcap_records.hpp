@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "coloc/io/bag_message.hpp"
+
 namespace coloc::io::detail::mcap {
 
 constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
@@ -100,6 +102,8 @@ class RecordCursor {
   std::size_t position() const { return position_; }
   std::size_t remaining() const { return size_ - position_; }
   const std::uint8_t* current() const { return data_ + position_; }
+  /// The record this cursor reads, as its errors name it (file and byte offset).
+  const std::string& where() const { return where_; }
   [[noreturn]] void fail(const std::string& reason) const;
 
  private:
@@ -117,6 +121,9 @@ MessageHeader parseMessageHeader(RecordCursor& c);
 ChunkHeader parseChunkHeader(RecordCursor& c);
 Statistics parseStatistics(RecordCursor& c);
 Footer parseFooter(RecordCursor& c);
+/// An Attachment record; its CRC, when not 0, is checked (the record's fields before it).
+BagAttachment parseAttachment(RecordCursor& c);
+BagMetadataRecord parseMetadata(RecordCursor& c);
 
 /// Appends little-endian fields to a record's content.
 class RecordBuilder {
@@ -140,6 +147,8 @@ void appendRecord(std::vector<std::uint8_t>& out, std::uint8_t opcode, const std
 
 std::vector<std::uint8_t> schemaContent(const SchemaRecord& schema);
 std::vector<std::uint8_t> channelContent(const ChannelRecord& channel);
+std::vector<std::uint8_t> attachmentContent(const BagAttachment& attachment);
+std::vector<std::uint8_t> metadataContent(const BagMetadataRecord& metadata);
 
 std::uint64_t readU64Le(const std::uint8_t* p);
 

@@ -55,6 +55,7 @@ struct McapWriter::Impl {
   bool chunk_has_message = false;
   std::map<std::uint16_t, std::vector<std::pair<std::uint64_t, std::uint64_t>>> chunk_message_index;
   std::vector<std::vector<std::uint8_t>> chunk_indexes;
+  std::vector<std::vector<std::uint8_t>> attachment_indexes, metadata_indexes;
 
   std::uint64_t message_count = 0;
   std::uint64_t start_time = 0, end_time = 0;
@@ -85,7 +86,9 @@ struct McapWriter::Impl {
     std::string encoding = topic.message_definition_encoding.empty() ? "ros2msg" : topic.message_definition_encoding;
     if (data.empty()) {
       data = rosMessageDefinition(topic.type);
-      encoding = "ros2msg";
+      // A type coloc has no definition of gets an empty encoding, as rosbag2 writes it: "ros2msg" with
+      // no text would tell readers the type has no fields, and they decode its messages to {}.
+      encoding = data.empty() ? "" : "ros2msg";
     }
     const auto key = std::make_tuple(topic.type, encoding, data);
     if (const auto found = schema_ids.find(key); found != schema_ids.end()) return found->second;
@@ -162,7 +165,8 @@ struct McapWriter::Impl {
   std::vector<std::uint8_t> statisticsContent() const {
     RecordBuilder b;
     b.u64(message_count).u16(static_cast<std::uint16_t>(schemas.size())).u32(static_cast<std::uint32_t>(channels.size()));
-    b.u32(0).u32(0).u32(chunk_count).u64(start_time).u64(end_time);  // no attachments or metadata records
+    b.u32(static_cast<std::uint32_t>(attachment_indexes.size())).u32(static_cast<std::uint32_t>(metadata_indexes.size()));
+    b.u32(chunk_count).u64(start_time).u64(end_time);
     std::map<std::uint16_t, std::uint64_t> counts;
     for (const auto& channel : channels) counts[channel.id] = 0;
     for (const auto& [id, count] : channel_counts) counts[id] = count;
@@ -190,6 +194,8 @@ struct McapWriter::Impl {
     writeGroup(groups, kChannel, records);
     writeGroup(groups, kStatistics, {statisticsContent()});
     writeGroup(groups, kChunkIndex, chunk_indexes);
+    writeGroup(groups, kAttachmentIndex, attachment_indexes);
+    writeGroup(groups, kMetadataIndex, metadata_indexes);
     summary_offset_start = position;
     for (const auto& group : groups) {
       RecordBuilder b;
@@ -266,6 +272,7 @@ void McapWriter::addTopic(const TopicInfo& topic) {
   channel.schema_id = w.schemaFor(topic);
   channel.topic = topic.name;
   channel.message_encoding = topic.serialization_format.empty() ? "cdr" : topic.serialization_format;
+  channel.metadata = topic.metadata;
   channel.metadata["offered_qos_profiles"] = topic.offered_qos_profiles;
   appendRecord(w.chunk, kChannel, channelContent(channel));
   w.channel_of_topic[topic.name] = channel.id;
@@ -290,6 +297,31 @@ void McapWriter::write(const std::string& topic, Stamp log_time, Stamp publish_t
 void McapWriter::write(const BagMessage& message) {
   write(message.topic, message.log_time, message.publish_time.value_or(message.log_time), message.data.data(),
         message.data.size());
+}
+
+// Attachments and metadata records stand between chunks, never inside one, and are indexed in the summary.
+void McapWriter::writeAttachment(const BagAttachment& attachment) {
+  Impl& w = *impl_;
+  if (w.closed) w.fail("writeAttachment after close");
+  if (attachment.log_time < 0 || attachment.create_time < 0) w.fail("attachment '" + attachment.name + "' has a negative time stamp");
+  w.flushChunk();
+  const std::uint64_t offset = w.position;
+  w.emitRecord(kAttachment, attachmentContent(attachment));
+  RecordBuilder index;
+  index.u64(offset).u64(w.position - offset).u64(static_cast<std::uint64_t>(attachment.log_time));
+  index.u64(static_cast<std::uint64_t>(attachment.create_time)).u64(attachment.data.size()).string(attachment.name).string(attachment.media_type);
+  w.attachment_indexes.push_back(index.content());
+}
+
+void McapWriter::writeMetadata(const BagMetadataRecord& metadata) {
+  Impl& w = *impl_;
+  if (w.closed) w.fail("writeMetadata after close");
+  w.flushChunk();
+  const std::uint64_t offset = w.position;
+  w.emitRecord(kMetadata, metadataContent(metadata));
+  RecordBuilder index;
+  index.u64(offset).u64(w.position - offset).string(metadata.name);
+  w.metadata_indexes.push_back(index.content());
 }
 
 void McapWriter::close() {

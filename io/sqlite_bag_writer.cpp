@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 
+#include "bag_compression.hpp"
 #include "bag_metadata.hpp"
 #include "coloc/core/error.hpp"
 #include "qos_profiles.hpp"
@@ -68,6 +69,7 @@ struct BagWriter::Impl {
   std::uint64_t message_count = 0;
   Stamp first_time = 0, last_time = 0;
   bool closed = false;
+  BagCompression compression = BagCompression::kNone;
 
   [[noreturn]] void fail(const std::string& reason) const { throw Error(db_path + ": " + reason); }
 
@@ -90,12 +92,17 @@ struct BagWriter::Impl {
   detail::BagMetadata metadata() const {
     detail::BagMetadata m;
     m.storage_identifier = "sqlite3";
-    m.relative_file_paths = {file_name};
+    const std::string stored = compression == BagCompression::kZstdFile ? file_name + ".zstd" : file_name;
+    if (compression != BagCompression::kNone) {
+      m.compression_format = "zstd";
+      m.compression_mode = compression == BagCompression::kZstdFile ? "FILE" : "MESSAGE";
+    }
+    m.relative_file_paths = {stored};
     m.starting_time = first_time;
     m.duration = last_time - first_time;
     m.message_count = message_count;
     m.topics = topics;
-    m.files = {{file_name, first_time, last_time - first_time, message_count}};
+    m.files = {{stored, first_time, last_time - first_time, message_count}};
     return m;
   }
 
@@ -116,12 +123,18 @@ struct BagWriter::Impl {
     db->execute("COMMIT;");
     insert_message.reset();
     db->close();
+    if (compression == BagCompression::kZstdFile) {
+      detail::compressZstdFile(db_path, db_path + ".zstd");
+      std::error_code ec;
+      fs::remove(db_path, ec);
+    }
     writeMetadataFile(m);
   }
 };
 
-BagWriter BagWriter::create(const std::string& directory) {
+BagWriter BagWriter::create(const std::string& directory, BagCompression compression) {
   auto impl = std::make_unique<Impl>();
+  impl->compression = compression;
   impl->directory = fs::path(directory);
   prepareDirectory(impl->directory);
   impl->file_name = bagName(impl->directory) + "_0.db3";
@@ -167,7 +180,12 @@ void BagWriter::write(const std::string& topic, Stamp log_time, const std::uint8
   if (w.closed) w.fail("write after close");
   const auto found = w.topic_ids.find(topic);
   if (found == w.topic_ids.end()) w.fail("topic " + topic + " was not declared with addTopic");
-  w.insert_message->bind(1, log_time).bind(2, found->second.first).bindBlob(3, data, size).execute();
+  if (w.compression == BagCompression::kZstdMessage) {
+    const std::vector<std::uint8_t> packed = detail::compressZstdMessage(data, size);
+    w.insert_message->bind(1, log_time).bind(2, found->second.first).bindBlob(3, packed.data(), packed.size()).execute();
+  } else {
+    w.insert_message->bind(1, log_time).bind(2, found->second.first).bindBlob(3, data, size).execute();
+  }
   w.first_time = w.message_count == 0 ? log_time : std::min(w.first_time, log_time);
   w.last_time = w.message_count == 0 ? log_time : std::max(w.last_time, log_time);
   ++w.message_count;

@@ -15,6 +15,9 @@ class StorageReader {
   virtual const std::vector<TopicInfo>& topics() const = 0;
   /// Next message in file order; false at the end. message.index is left to the caller.
   virtual bool next(BagMessage& message) = 0;
+  /// Attachments and metadata records met by next() so far (all of them once it returned false).
+  virtual std::vector<BagAttachment> takeAttachments() { return {}; }
+  virtual std::vector<BagMetadataRecord> takeMetadata() { return {}; }
 };
 
 /// Throw coloc::Error naming the file and the reason.

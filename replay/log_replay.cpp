@@ -44,10 +44,11 @@ std::vector<Event> decodeAll(io::BagReader& bag, const pipeline::Config& config,
   std::vector<Event> events;
   const std::uint64_t total = std::max<std::uint64_t>(bag.messageCount(), 1);
   io::BagMessage message;
+  // Earliest and latest, not first and last: files need not be in time order.
   Stamp first_log = 0, last_log = 0;
   while (bag.next(message)) {
-    if (result.messages_read == 0) first_log = message.log_time;
-    last_log = message.log_time;
+    first_log = result.messages_read == 0 ? message.log_time : std::min(first_log, message.log_time);
+    last_log = result.messages_read == 0 ? message.log_time : std::max(last_log, message.log_time);
     if (progress && result.messages_read % 256 == 0) progress(0.5 * result.messages_read / total);
     ++result.messages_read;
     const auto found = topic_index.find(message.topic);
@@ -230,6 +231,17 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   io::BagReader bag = io::BagReader::open(log_path);
   ReplayResult result;
   result.topics = planTopics(bag.topics(), config, !options.map.empty(), registry ? &*registry : nullptr, result.rejections);
+  const bool has_input = std::any_of(result.topics.begin(), result.topics.end(), [](const TopicUse& t) {
+    return t.role == InputRole::kPose || t.role == InputRole::kTwist || t.role == InputRole::kScan || t.role == InputRole::kRsuFix;
+  });
+  if (!has_input) {
+    std::vector<TopicUse> listed = result.topics;
+    for (TopicUse& t : listed)
+      for (const io::TopicInfo& info : bag.topics())
+        if (info.name == t.topic) t.messages = info.message_count;
+    throw Error(log_path + ": nothing to fuse: no topic is a pose, twist, scan (with a map) or RSU fix input. The log holds:\n" +
+                describeTopics(listed));
+  }
   std::vector<Event> events = decodeAll(bag, config, result, options.progress);
   placeOnStampClock(events, config, result);
   emulateLinks(events, config, result);
@@ -238,6 +250,9 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     return a.arrival != b.arrival ? a.arrival < b.arrival : a.order < b.order;
   });
   drive(events, options, std::move(registry), result);
+  if (result.fused.empty())
+    throw Error(log_path + ": nothing fused: no input gave the filter a pose it could start from or accept (" +
+                std::to_string(result.messages_read) + " messages read). The log holds:\n" + describeTopics(result.topics));
   if (!result.fused.empty()) {
     result.first_stamp = result.fused.front().stamp;
     result.last_stamp = result.fused.back().stamp;

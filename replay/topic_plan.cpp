@@ -106,4 +106,16 @@ std::vector<TopicUse> planTopics(const std::vector<io::TopicInfo>& topics, const
   return plan;
 }
 
+std::string describeTopics(const std::vector<TopicUse>& topics) {
+  if (topics.empty()) return "  (no topics)\n";
+  std::string out;
+  for (const TopicUse& t : topics) {
+    out += "  " + t.topic + " (" + (t.type.empty() ? std::string("type unknown") : t.type) + "), " + std::to_string(t.messages) + " messages: ";
+    out += t.role == InputRole::kIgnore ? "not used" + (t.note.empty() ? std::string() : " (" + t.note + ")") : std::string("role ") + toString(t.role);
+    if (t.decode_errors) out += "; " + std::to_string(t.decode_errors) + " undecodable, first: " + t.first_error;
+    out += "\n";
+  }
+  return out;
+}
+
 }  // namespace coloc::replay

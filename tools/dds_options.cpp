@@ -5,19 +5,23 @@
 namespace coloc::tools {
 
 void addDdsOptions(CLI::App* cmd, DdsOptions& o) {
-  cmd->add_option("--domain", o.domain, "DDS domain (ROS_DOMAIN_ID)")->capture_default_str();
+  cmd->add_option("--domain", o.domain, "DDS domain, 0-232 (default: ROS_DOMAIN_ID, else 0)")->check(CLI::Range(0, 232));
   cmd->add_flag("--reliable", o.reliable, "reliable QoS instead of ROS 2 sensor data (best effort, keep last 5)");
-  cmd->add_flag("--any-interface", o.any_interface, "Fast DDS default transports instead of UDP on loopback");
+  auto* loopback = cmd->add_flag("--loopback-only", o.loopback_only,
+                                 "UDP on 127.0.0.1 only, unicast discovery: nothing leaves the machine (also ROS_LOCALHOST_ONLY=1); "
+                                 "default: Fast DDS's defaults as a ROS 2 node uses them (multicast discovery on every interface, shared memory)");
+  cmd->add_flag("--any-interface", o.any_interface, "every interface even when ROS_LOCALHOST_ONLY=1")->excludes(loopback);
   cmd->add_option("--security", o.security_dir,
                   "folder with DDS Security files: identity_ca.pem, permissions_ca.pem, governance.p7s, NAME.pem, "
                   "NAME_key.pem, NAME_permissions.p7s (NAME: --name)");
 }
 
 rsu_client::DdsConfig ddsConfig(const DdsOptions& o, const std::string& default_name) {
-  rsu_client::DdsConfig c;
-  c.domain = o.domain;
+  rsu_client::DdsConfig c = rsu_client::ddsConfigFromRosEnvironment();
+  if (o.domain) c.domain = *o.domain;
   c.reliable = o.reliable;
-  c.loopback_only = !o.any_interface;
+  if (o.loopback_only) c.loopback_only = true;
+  if (o.any_interface) c.loopback_only = false;
   c.participant_name = o.name.empty() ? default_name : o.name;
   if (!o.security_dir.empty()) {
     const std::string d = o.security_dir + "/", n = c.participant_name;

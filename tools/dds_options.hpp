@@ -1,6 +1,7 @@
 #pragma once
 // The DDS options every networked command shares (domain, QoS, interfaces, DDS Security files).
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "coloc/rsu_client/dds_transport.hpp"
@@ -8,9 +9,10 @@
 namespace coloc::tools {
 
 struct DdsOptions {
-  int domain = 0;
+  std::optional<int> domain;  ///< unset: ROS_DOMAIN_ID, else 0
   bool reliable = false;
-  bool any_interface = false;
+  bool loopback_only = false;  ///< also when ROS_LOCALHOST_ONLY=1
+  bool any_interface = false;  ///< overrides ROS_LOCALHOST_ONLY=1
   std::string security_dir;  ///< folder with identity_ca.pem, <name>.pem, <name>_key.pem, governance.p7s, <name>_permissions.p7s
   std::string name;
 };

@@ -88,10 +88,10 @@ void addLocalizeCommand(CLI::App& app) {
     live::LiveLocalizer localizer(options);
     watchdog.disarm();
     const TeardownWatchdog::ArmOnExit arm_on_exit(watchdog);
-    std::printf("localizing: scans %s, twist %s (%s), initial pose %s; out %s and %s; domain %d%s\n", options.config.live.scan_topic.c_str(),
+    std::printf("localizing: scans %s, twist %s (%s), initial pose %s; out %s and %s; domain %d, %s%s\n", options.config.live.scan_topic.c_str(),
                 options.config.live.twist_topic.c_str(), options.config.live.twist_type.c_str(), options.config.live.initial_pose_topic.c_str(),
                 options.config.live.pose_topic.c_str(), options.config.live.odometry_topic.c_str(), options.dds.domain,
-                sim_time ? "; time from /clock" : "");
+                options.dds.loopback_only ? "loopback only" : "every interface", sim_time ? "; time from /clock" : "");
     std::fflush(stdout);
 
     const auto start = std::chrono::steady_clock::now();

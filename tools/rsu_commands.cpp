@@ -33,7 +33,7 @@ std::vector<rsu_client::RsuFix> fixesFromFile(const std::string& path, const std
     char c1, c2;
     if (!(s >> t >> c1 >> x >> c2 >> y) || c1 != ',' || c2 != ',')
       throw Error(path + ":" + std::to_string(number) + ": expected 't_offset_s,x,y'");
-    fixes.push_back({fromSeconds(t), rsu, x, y, std::nullopt});
+    fixes.push_back({fromSeconds(t), rsu, x, y, std::nullopt, std::nullopt});
   }
   return fixes;
 }
@@ -87,8 +87,8 @@ void addRsuListenCommand(CLI::App& app) {
     if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
     watchdog.disarm();
     const TeardownWatchdog::ArmOnExit arm_on_exit(watchdog);
-    std::printf("listening on %zu RSU topics (%s), domain %d\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
-                config.domain);
+    std::printf("listening on %zu RSU topics (%s), domain %d, %s\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
+                config.domain, config.loopback_only ? "loopback only" : "every interface");
     std::fflush(stdout);
     const auto start = std::chrono::steady_clock::now();
     const auto idle_for = [&] {
@@ -148,7 +148,7 @@ void addRsuPublishCommand(CLI::App& app) {
     if (!from.empty()) fixes = fixesFromFile(from, rsu);
     for (int i = 0; i < generate; ++i) {  // a straight pass 3 m from the RSU, centred on it
       const double t = i / rate, along = -0.5 * speed * generate / rate + speed * t;
-      fixes.push_back({fromSeconds(t), rsu, info->position.x() + along, info->position.y() + 3.0, std::nullopt});
+      fixes.push_back({fromSeconds(t), rsu, info->position.x() + along, info->position.y() + 3.0, std::nullopt, std::nullopt});
     }
     if (fixes.empty()) throw Error("rsu-publish: nothing to send (give --from or --generate)");
     const rsu_client::DdsConfig config = ddsConfig(dds, rsu);

@@ -76,7 +76,7 @@ int main() {
     if (k % 5 == 0) pipeline.pushScan(scanAt(world, kSpeed * k * 0.02, rng), t, t + 30'000'000);
     if (k == 367) {
       const coloc::Stamp taken = t + 10'000'000;
-      pipeline.pushFix({taken, "rsu_a", kSpeed * coloc::toSeconds(taken - kStart) + 0.004, -0.003, std::nullopt}, taken + 120'000'000);
+      pipeline.pushFix({taken, "rsu_a", kSpeed * coloc::toSeconds(taken - kStart) + 0.004, -0.003, std::nullopt, std::nullopt}, taken + 120'000'000);
     }
     pipeline.runUntil(t + 2'000'000);  // offline here; a live stack calls pipeline.start() instead
   }

@@ -205,6 +205,38 @@ TEST(McapCorruption, UnchunkedFileWithoutSummaryIsRead) {
   EXPECT_FALSE(reader.next(m));
 }
 
+TEST(McapCorruption, ASummaryRepeatingChannelsButNotSchemasFindsTheSchemasInTheDataSection) {
+  // Valid MCAP (a writer with repeatSchemas off): the summary names channel 3 on schema 1, which only
+  // the data section defines.
+  ScratchDir dir;
+  RawFile file;
+  file.raw(kMagic).record(0x01, header());
+  file.record(0x03, schema(1)).record(0x04, channel(3, 1, "/chatter")).record(0x05, message(3, 10, "abcd"));
+  file.record(0x0F, RawFile().u32(0));
+  const std::uint64_t summary_start = file.size();
+  file.record(0x04, channel(3, 1, "/chatter"));
+  file.record(0x02, RawFile().u64(summary_start).u64(0).u32(0)).raw(kMagic);
+  const std::string path = writeFile(dir, "no_schemas_in_summary.mcap", file);
+  BagReader reader = BagReader::open(path);
+  ASSERT_EQ(reader.topics().size(), 1u);
+  EXPECT_EQ(reader.topics()[0].type, "std_msgs/msg/String");
+  EXPECT_EQ(reader.topics()[0].message_definition, "string data");
+  EXPECT_EQ(reader.topics()[0].message_count, 1u);
+  BagMessage m;
+  ASSERT_TRUE(reader.next(m));
+  EXPECT_EQ(std::string(m.data.begin(), m.data.end()), "abcd");
+}
+
+TEST(McapCorruption, AChannelOnASchemaDefinedNowhereNamesItsByteOffset) {
+  ScratchDir dir;
+  RawFile records;
+  records.record(0x03, schema(1)).record(0x04, channel(3, 7, "/chatter"));
+  const std::string path = writeFile(dir, "schema7.mcap", unchunkedFile(records));
+  const std::string error = errorMessage([&] { openAndReadAll(path); });
+  EXPECT_NE(error.find("Channel record at byte offset"), std::string::npos) << error;
+  EXPECT_NE(error.find("refers to schema 7"), std::string::npos) << error;
+}
+
 TEST(McapCorruption, TruncatedFieldInsideARecordNamesTheField) {
   ScratchDir dir;
   RawFile records;
@@ -234,8 +266,8 @@ std::string tinyFile(const ScratchDir& dir, bool crcs) {
   options.write_crcs = crcs;
   options.chunk_size = 80;
   McapWriter writer = McapWriter::create(path, options);
-  writer.addTopic({"/a", "", "cdr", "q", "", "", 0});
-  writer.addTopic({"/b", "", "cdr", "", "", "", 0});
+  writer.addTopic({"/a", "", "cdr", "q", "", "", 0, {}});
+  writer.addTopic({"/b", "", "cdr", "", "", "", 0, {}});
   const std::uint8_t payload[6] = {0, 1, 0, 0, 42, 43};
   for (int i = 0; i < 5; ++i) writer.write(i % 2 ? "/a" : "/b", 100 + i, 100 + i, payload, sizeof payload);
   writer.close();

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "coloc/io/bag_reader.hpp"
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
@@ -98,8 +100,8 @@ TEST(McapWriter, KnownTypesGetColocsSchemaAndMessagesKeepTheirBytes) {
   const Bytes bytes = encodePoseWithCovarianceStamped(pose);
   {
     McapWriter writer = McapWriter::create(path);
-    writer.addTopic({"/rsu/pose", "geometry_msgs/msg/PoseWithCovarianceStamped", "cdr", "", "", "", 0});
-    writer.addTopic({"/blob", "", "cdr", "", "", "", 0});  // no type: no schema
+    writer.addTopic({"/rsu/pose", "geometry_msgs/msg/PoseWithCovarianceStamped", "cdr", "", "", "", 0, {}});
+    writer.addTopic({"/blob", "", "cdr", "", "", "", 0, {}});  // no type: no schema
     writer.write("/rsu/pose", 5, 4, bytes.data(), bytes.size());
     writer.write("/blob", 6, 6, bytes.data(), 4);
     writer.close();
@@ -117,6 +119,67 @@ TEST(McapWriter, KnownTypesGetColocsSchemaAndMessagesKeepTheirBytes) {
   ASSERT_TRUE(reader.next(message));
   EXPECT_EQ(message.topic, "/blob");
   EXPECT_EQ(message.data.size(), 4u);
+}
+
+TEST(McapWriter, ATypeColocCannotDefineGetsAnEmptySchemaEncodingAsRosbag2Writes) {
+  ScratchDir dir;
+  const std::string path = dir / "tf.mcap";
+  {
+    McapWriter writer = McapWriter::create(path);
+    writer.addTopic({"/tf", "tf2_msgs/msg/TFMessage", "cdr", "", "", "", 0, {}});
+    writer.close();
+  }
+  BagReader reader = BagReader::open(path);
+  ASSERT_EQ(reader.topics().size(), 1u);
+  EXPECT_EQ(reader.topics()[0].type, "tf2_msgs/msg/TFMessage");
+  // "ros2msg" with no text would say the type has no fields: readers would decode every /tf to {}.
+  EXPECT_EQ(reader.topics()[0].message_definition_encoding, "");
+  EXPECT_EQ(reader.topics()[0].message_definition, "");
+}
+
+TEST(McapWriter, ChannelMetadataAttachmentsAndMetadataRecordsSurviveMcapToMcap) {
+  ScratchDir dir;
+  const std::string first = dir / "first.mcap", second = dir / "second.mcap";
+  TopicInfo topic{"/chatter", "std_msgs/msg/String", "cdr", "", "string data", "ros2msg", 0, {}};
+  topic.metadata = {{"topic_type_hash", "RIHS01_5e1b"}, {"site", "A"}};
+  BagAttachment attachment{5, 4, "calibration.yaml", "application/yaml", {'x', ':', ' ', '1'}};
+  BagMetadataRecord record{"recording", {{"vehicle", "ego"}, {"weather", "dry"}}};
+  {
+    McapWriter writer = McapWriter::create(first);
+    writer.addTopic(topic);
+    const std::uint8_t payload[] = {0, 1, 0, 0, 3, 0, 0, 0, 'h', 'i', 0, 0};
+    writer.write("/chatter", 10, 10, payload, sizeof payload);
+    writer.writeAttachment(attachment);
+    writer.writeMetadata(record);
+    writer.close();
+  }
+  const ConvertSummary summary = convert(first, second);
+  EXPECT_EQ(summary.attachments, 1u);
+  EXPECT_EQ(summary.metadata_records, 1u);
+  BagReader reader = BagReader::open(second);
+  ASSERT_EQ(reader.topics().size(), 1u);
+  EXPECT_EQ(reader.topics()[0].metadata, topic.metadata);
+  BagMessage m;
+  while (reader.next(m)) {
+  }
+  ASSERT_EQ(reader.attachments().size(), 1u);
+  const BagAttachment& a = reader.attachments()[0];
+  EXPECT_EQ(a.name, attachment.name);
+  EXPECT_EQ(a.media_type, attachment.media_type);
+  EXPECT_EQ(a.log_time, attachment.log_time);
+  EXPECT_EQ(a.create_time, attachment.create_time);
+  EXPECT_EQ(a.data, attachment.data);
+  ASSERT_EQ(reader.metadataRecords().size(), 1u);
+  EXPECT_EQ(reader.metadataRecords()[0].name, record.name);
+  EXPECT_EQ(reader.metadataRecords()[0].entries, record.entries);
+  // A damaged attachment is refused by its CRC, naming it.
+  std::vector<std::uint8_t> bytes = testing::readBytes(second);
+  const auto at = std::search(bytes.begin(), bytes.end(), attachment.data.begin(), attachment.data.end());
+  ASSERT_NE(at, bytes.end());
+  *at ^= 0x01;
+  testing::writeBytes(dir / "damaged.mcap", bytes);
+  const std::string error = testing::errorMessage([&] { testing::openAndReadAll(dir / "damaged.mcap"); });
+  EXPECT_NE(error.find("attachment 'calibration.yaml' CRC mismatch"), std::string::npos) << error;
 }
 
 TEST(McapWriter, EmptyFileIsValid) {
@@ -141,8 +204,8 @@ TEST(McapWriter, UndeclaredTopicsAndNegativeTimesAreErrors) {
   const std::uint8_t byte = 0;
   EXPECT_NE(errorMessage([&] { writer.write("/nope", 1, 1, &byte, 1); }).find("/nope was not declared"),
             std::string::npos);
-  writer.addTopic({"/a", "std_msgs/msg/String", "cdr", "", "", "", 0});
-  EXPECT_NE(errorMessage([&] { writer.addTopic({"/a", "x/msg/Y", "cdr", "", "", "", 0}); }).find("declared twice"),
+  writer.addTopic({"/a", "std_msgs/msg/String", "cdr", "", "", "", 0, {}});
+  EXPECT_NE(errorMessage([&] { writer.addTopic({"/a", "x/msg/Y", "cdr", "", "", "", 0, {}}); }).find("declared twice"),
             std::string::npos);
   EXPECT_NE(errorMessage([&] { writer.write("/a", -1, 0, &byte, 1); }).find("negative time stamp"),
             std::string::npos);

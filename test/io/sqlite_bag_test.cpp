@@ -164,7 +164,7 @@ TEST(SqliteBag, WrittenMessagesComeBackInTimestampOrder) {
   ScratchDir dir;
   {
     BagWriter writer = BagWriter::create(dir / "order");
-    writer.addTopic({"/a", "std_msgs/msg/String", "cdr", "", "", "", 0});
+    writer.addTopic({"/a", "std_msgs/msg/String", "cdr", "", "", "", 0, {}});
     const std::uint8_t payload[] = {1, 2, 3};
     for (const Stamp t : {30, 10, 20, 10}) writer.write("/a", t, payload, sizeof payload);
     EXPECT_NE(errorMessage([&] { writer.write("/b", 1, payload, 1); }).find("/b was not declared"), std::string::npos);

@@ -35,10 +35,12 @@ TEST(LiveLocalizer, MalformedAndInvalidSamplesAreCountedAndTheNodeKeepsRunning) 
   options.registry = rsu_client::RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [0, 0], lidar_model: VLP-32C}\n", "test");
   options.config.live.reliable = true;  // on loopback every loss would be coloc's
   options.dds.domain = 79;
+  options.dds.loopback_only = true;  // a unit test talks to nothing beyond 127.0.0.1
   LiveLocalizer localizer(options);
 
   rsu_client::DdsConfig dds;
   dds.domain = 79;
+  dds.loopback_only = true;
   dds.participant_name = "intruder";
   rsu_client::DdsNode node(dds);
   rsu_client::TopicQos qos;

@@ -9,6 +9,8 @@ coloc=$1
 scenario=$2
 source "$(dirname "$0")/../support/in_network_namespace.sh"
 source "$(dirname "$0")/../support/process_logs.sh"
+# Loopback only, as a ROS 2 node is told with ROS_LOCALHOST_ONLY: nothing leaves the machine.
+export ROS_LOCALHOST_ONLY=1
 
 "$coloc" simulate "$scenario" --out "$work/sim" > "$work/simulate.txt"
 "$coloc" fuse "$work/sim/log" --map "$work/sim/map" --config "$work/sim/fuse.yaml" --out "$work/offline" > "$work/fuse.txt"

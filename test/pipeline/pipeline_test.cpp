@@ -29,7 +29,7 @@ rsu_client::RsuRegistry oneRsu() {
 
 const Config kConfig;
 
-rsu_client::RsuFix fixAt(Stamp stamp, double x, double y) { return {stamp, "rsu_a", x, y, std::nullopt}; }
+rsu_client::RsuFix fixAt(Stamp stamp, double x, double y) { return {stamp, "rsu_a", x, y, std::nullopt, std::nullopt}; }
 
 // A vehicle at 5 m/s along x from the origin: twists at 50 Hz, a starting pose, and a fix at `fix_stamp`
 // arriving `fix_delay` later. Returns the last estimate.
@@ -88,7 +88,7 @@ TEST(Pipeline, FixesPassTheRegistrysChecksBeforeReachingTheFilter) {
   pipe.onRejection([&](const std::string& line) { rejections.push_back(line); });
   pipe.pushInitialPose(planarPose(kStart, 10.0, 0.0, 0.0), kStart);
   pipe.pushFix(fixAt(kStart + kTick, 100.0, 0.0), kStart + kTick);          // 90 m from the RSU: outside its coverage
-  pipe.pushFix({kStart + kTick, "rsu_x", 10.0, 0.0, std::nullopt}, kStart + kTick);  // an RSU nobody registered
+  pipe.pushFix({kStart + kTick, "rsu_x", 10.0, 0.0, std::nullopt, std::nullopt}, kStart + kTick);  // an RSU nobody registered
   pipe.pushFix(fixAt(kStart + 2 * kTick, 10.01, 0.0), kStart + 2 * kTick);  // a good one
   pipe.runUntil(kStart + 10 * kTick);
   const PipelineReport r = pipe.report();

@@ -7,6 +7,7 @@
 
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_writer.hpp"
+#include "coloc/io/mcap_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/replay/log_replay.hpp"
@@ -247,9 +248,64 @@ TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {
     bag.write("/points", 1'000'000'000, b.data(), b.size());
     bag.close();
   }
-  const ReplayResult r = replayLog(dir / "scans", ReplayOptions());
-  EXPECT_EQ(topic(r, "/points").role, InputRole::kIgnore);
-  EXPECT_NE(topic(r, "/points").note.find("--map"), std::string::npos);
+  // Nothing else in the log: there is nothing to fuse, and the error lists what the log holds and why.
+  try {
+    replayLog(dir / "scans", ReplayOptions());
+    ADD_FAILURE() << "a log with nothing to fuse was replayed";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("nothing to fuse"), std::string::npos) << what;
+    EXPECT_NE(what.find("/points (sensor_msgs/msg/PointCloud2), 1 messages: not used"), std::string::npos) << what;
+    EXPECT_NE(what.find("--map"), std::string::npos) << what;
+  }
+}
+
+TEST(LogReplay, ALogWhosePosesCannotStartTheFilterIsAnErrorListingItsTopics) {
+  testing::TempDir dir;
+  {
+    io::BagWriter bag = io::BagWriter::create(dir / "zero");
+    bag.addTopic(topicOf("/ndt_pose", "geometry_msgs/msg/PoseWithCovarianceStamped"));
+    bag.addTopic(topicOf("/chatter", "std_msgs/msg/String"));
+    io::StampedPose p;
+    p.header = {0, "map"};
+    p.measurement.covariance = Matrix6d::Identity() * std::nan("");  // every pose unusable
+    const io::Bytes b = io::encodePoseWithCovarianceStamped(p);
+    for (int i = 0; i < 3; ++i) bag.write("/ndt_pose", 0, b.data(), b.size());
+    const std::uint8_t text[] = {0, 1, 0, 0, 3, 0, 0, 0, 'h', 'i', 0, 0};
+    bag.write("/chatter", 0, text, sizeof text);
+    bag.close();
+  }
+  try {
+    replayLog(dir / "zero", ReplayOptions());
+    ADD_FAILURE() << "a log that fused nothing was reported as fused";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("nothing fused"), std::string::npos) << what;
+    EXPECT_NE(what.find("/ndt_pose (geometry_msgs/msg/PoseWithCovarianceStamped), 3 messages: role pose"), std::string::npos) << what;
+    EXPECT_NE(what.find("/chatter (std_msgs/msg/String), 1 messages: not used"), std::string::npos) << what;
+  }
+}
+
+TEST(LogReplay, TheLogsDurationRunsFromItsEarliestToItsLatestTimeWhateverTheFileOrder) {
+  testing::TempDir dir;
+  const std::string path = dir / "shuffled.mcap";
+  {
+    // MCAP keeps the order of writing: the latest message first, the earliest last.
+    io::McapWriter bag = io::McapWriter::create(path);
+    bag.addTopic(topicOf("/ndt_pose", "geometry_msgs/msg/PoseWithCovarianceStamped"));
+    const Stamp t0 = 1'700'000'000'000'000'000LL;
+    for (const int k : {4, 1, 2, 3, 0}) {
+      io::StampedPose p;
+      p.header = {t0 + k * 100'000'000LL, "map"};
+      p.measurement.pose.position = {0.5 * k, 0.0, 0.0};
+      p.measurement.covariance = Matrix6d::Identity() * 0.01;
+      const io::Bytes b = io::encodePoseWithCovarianceStamped(p);
+      bag.write("/ndt_pose", t0 + k * 100'000'000LL, t0 + k * 100'000'000LL, b.data(), b.size());
+    }
+    bag.close();
+  }
+  const ReplayResult r = replayLog(path, ReplayOptions());
+  EXPECT_NEAR(r.log_duration, 0.4, 1e-9);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@ DdsConfig testConfig(int domain) {
   DdsConfig c;
   c.domain = domain;  // a domain of its own so that other tests' participants do not match
   c.reliable = true;  // one process, no loss expected: make the count exact
+  c.loopback_only = true;  // a unit test talks to nothing beyond 127.0.0.1
   return c;
 }
 
@@ -39,7 +40,7 @@ TEST(DdsLoopback, FixesArriveOnTheirRsuTopicWithStampAndPosition) {
   FixPublisher publisher(testConfig(71), "rsu_b");
   ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
   const Stamp t0 = systemNow();
-  for (int i = 0; i < 5; ++i) publisher.publish({t0 + i * 100'000'000LL, "rsu_b", 200.0 + i, 6.0, std::nullopt}, 0.00681);
+  for (int i = 0; i < 5; ++i) publisher.publish({t0 + i * 100'000'000LL, "rsu_b", 200.0 + i, 6.0, std::nullopt, std::nullopt}, 0.00681);
   ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 5; }, std::chrono::seconds(10)));
   std::lock_guard<std::mutex> lock(mutex);
   for (int i = 0; i < 5; ++i) {
@@ -79,7 +80,7 @@ TEST(DdsLoopback, AnUndecodableFixSampleIsCountedAndTheListenerGoesOn) {
                         std::chrono::seconds(10)));
   FixPublisher publisher(testConfig(73), "rsu_a");
   ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
-  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt}, 0.00681);
+  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt}, 0.00681);
   ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 1; }, std::chrono::seconds(10)));
   const SampleCounters c = subscriber.sampleCounters();
   EXPECT_EQ(c.wrong_encapsulation, 1u);

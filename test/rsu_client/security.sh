@@ -10,6 +10,8 @@ registry=$2
 make_security=$3
 source "$(dirname "$0")/../support/in_network_namespace.sh"
 source "$(dirname "$0")/../support/process_logs.sh"
+# Loopback only, as a ROS 2 node is told with ROS_LOCALHOST_ONLY: nothing leaves the machine.
+export ROS_LOCALHOST_ONLY=1
 "$make_security" "$work/sec" rsu_a rsu_b > /dev/null
 # Intruders send from x = 999 so that any of their fixes that got through would stand out.
 printf '0.0,999,0\n0.1,999,0\n0.2,999,0\n0.3,999,0\n' > "$work/intruder.csv"

@@ -9,6 +9,8 @@ coloc=$1
 registry=$2
 source "$(dirname "$0")/../support/in_network_namespace.sh"
 source "$(dirname "$0")/../support/process_logs.sh"
+# Loopback only, as a ROS 2 node is told with ROS_LOCALHOST_ONLY: nothing leaves the machine.
+export ROS_LOCALHOST_ONLY=1
 printf '0.00,95,-3\n0.05,96,-3\n0.10,500,500\n' > "$work/extra.csv"
 
 # The listener stops 4 s after the last fix (both publishers have sent by then), or after 60 s.

@@ -38,6 +38,11 @@ class BagReader {
   /// Reuses message.data's capacity. Throws coloc::Error on corrupt data.
   bool next(BagMessage& message);
 
+  /// MCAP attachments and metadata records of the files next() has finished (all of them once it
+  /// returned false); rosbag2 sqlite3 storage has neither.
+  const std::vector<BagAttachment>& attachments() const;
+  const std::vector<BagMetadataRecord>& metadataRecords() const;
+
  private:
   struct Impl;
   explicit BagReader(std::unique_ptr<Impl> impl);

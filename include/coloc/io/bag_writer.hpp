@@ -14,10 +14,14 @@
 
 namespace coloc::io {
 
+/// rosbag2's compression of a sqlite3 bag: none, the whole database file (FILE mode, "OUT_0.db3.zstd")
+/// or each message (MESSAGE mode), zstd as rosbag2 writes it.
+enum class BagCompression : std::uint8_t { kNone, kZstdFile, kZstdMessage };
+
 class BagWriter {
  public:
   /// Creates the bag directory (and its parents); refuses an existing non-empty directory or a file.
-  static BagWriter create(const std::string& directory);
+  static BagWriter create(const std::string& directory, BagCompression compression = BagCompression::kNone);
 
   ~BagWriter();  ///< closes if close() was not called, swallowing errors: call close() to see them
   BagWriter(BagWriter&&) noexcept;
@@ -42,11 +46,14 @@ class BagWriter {
 
 struct ConvertOptions {
   McapWriterOptions mcap;  ///< used when the output is a .mcap file
+  BagCompression sqlite_compression = BagCompression::kNone;  ///< used when the output is a sqlite3 bag
 };
 
 struct ConvertSummary {
   std::vector<TopicInfo> topics;
   std::uint64_t message_count = 0;
+  /// MCAP attachments and metadata records read: copied to an MCAP output, which rosbag2 sqlite3 cannot hold.
+  std::uint64_t attachments = 0, metadata_records = 0;
 };
 
 /// Copies every message of `input` (anything BagReader::open accepts) to `output`: an MCAP file if the

@@ -1,7 +1,8 @@
 #pragma once
 // Writes MCAP files with the ros2 profile: schemas in ros2msg encoding (the definition the topic
-// carries, else coloc's own for the types it knows, else empty), channels with message_encoding "cdr"
-// and the offered_qos_profiles metadata, messages in chunks compressed with zstd, lz4 (frame format)
+// carries, else coloc's own for the types it knows, else an empty schema with an empty encoding, as
+// rosbag2 writes it), channels with message_encoding "cdr", the offered_qos_profiles and the topic's
+// other metadata, attachments and metadata records, messages in chunks compressed with zstd, lz4 (frame format)
 // or not at all, and optionally message indexes and a summary section. Output is deterministic: the
 // same calls give the same bytes.
 #include <cstddef>
@@ -38,6 +39,10 @@ class McapWriter {
              std::size_t size);
   /// Writes a read message; publish_time defaults to log_time as MCAP requires.
   void write(const BagMessage& message);
+  /// A file stored beside the messages, and named key-value pairs (MCAP Attachment and Metadata
+  /// records, indexed in the summary).
+  void writeAttachment(const BagAttachment& attachment);
+  void writeMetadata(const BagMetadataRecord& metadata);
   /// Flushes the last chunk, writes the summary and footer. Further writes are errors.
   void close();
 

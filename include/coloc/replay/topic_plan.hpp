@@ -42,4 +42,8 @@ std::optional<std::string> rsuOfTopic(const std::string& topic, const rsu_client
 std::vector<TopicUse> planTopics(const std::vector<io::TopicInfo>& topics, const pipeline::Config& config, bool have_map,
                                  const rsu_client::RsuRegistry* registry, std::vector<std::string>& notes);
 
+/// What a log holds, a line per topic (name, type, messages, role or why it is skipped, decode errors):
+/// what an error says when a log gives the filter nothing to fuse.
+std::string describeTopics(const std::vector<TopicUse>& topics);
+
 }  // namespace coloc::replay

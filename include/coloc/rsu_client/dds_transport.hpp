@@ -31,13 +31,21 @@ struct DdsConfig {
   int domain = 0;           ///< ROS_DOMAIN_ID
   bool reliable = false;    ///< false: ROS 2 sensor-data QoS (best effort)
   int depth = 5;            ///< keep-last depth
-  /// UDP on 127.0.0.1 with unicast discovery: works in containers without shared memory and sends
-  /// nothing beyond the machine. Off: default Fast DDS transports (UDP multicast discovery on every
-  /// interface, shared memory).
-  bool loopback_only = true;
+  /// false (default): Fast DDS's default transports, those a ROS 2 node on rmw_fastrtps uses:
+  /// discovery by multicast (239.255.0.1, port 7400 + 250 x domain) and unicast on every interface,
+  /// shared memory between processes of one host. A default-configured ROS 2 node (rmw_fastrtps or
+  /// rmw_cyclonedds) finds coloc on the same host and across the vehicle network.
+  /// true: UDP on 127.0.0.1 only, discovery by unicast to the peers there (ROS_LOCALHOST_ONLY=1):
+  /// nothing leaves the machine, and it works in containers without shared memory.
+  bool loopback_only = false;
   std::string participant_name = "coloc";
   SecurityConfig security;
 };
+
+/// The defaults a ROS 2 node takes from its environment: the domain from ROS_DOMAIN_ID (0-232; unset
+/// or empty: 0) and loopback only when ROS_LOCALHOST_ONLY is 1. Throws coloc::Error naming the
+/// variable and its value when it is malformed.
+DdsConfig ddsConfigFromRosEnvironment();
 
 /// The ROS topic a fix of this RSU travels on; DDS adds the "rt" prefix.
 std::string fixTopic(const std::string& rsu_id);
