@@ -130,12 +130,17 @@ void YamlReader::requireMap(const YAML::Node& node, const std::string& key) cons
   if (!node.IsMap()) fail(node, key, "expected a mapping of keys to values");
 }
 
+std::string YamlReader::key(const YAML::Node& key_node) const {
+  if (!key_node.IsScalar()) fail(key_node, "(a key)", "a key must be plain text, not a list or a mapping");
+  return key_node.Scalar();
+}
+
 void YamlReader::allowKeys(const YAML::Node& node, const std::string& where, std::initializer_list<const char*> allowed) const {
   requireMap(node, where);
   std::string list;
   for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
   for (const auto& entry : node) {
-    const std::string k = entry.first.as<std::string>();
+    const std::string k = key(entry.first);
     bool ok = false;
     for (const char* a : allowed) ok = ok || k == a;
     if (!ok) fail(entry.first, (where.empty() || where == "(top level)" ? "" : where + ".") + k, "unknown key (" + list + ")");

@@ -68,7 +68,7 @@ std::string quoted(const std::string& s) { return s.empty() ? std::string("null"
 void readFusion(const YamlReader& r, const YAML::Node& node, fusion::EkfConfig& config) {
   r.requireMap(node, "fusion");
   for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     const fusion::EkfParam* param = nullptr;
     for (const auto& p : fusion::ekfParams())
       if (key == p.key) param = &p;
@@ -101,7 +101,7 @@ rsu_client::LinkConfig readLink(const YamlReader& r, const YAML::Node& node, con
   r.allowKeys(node, where, {"delay", "jitter", "loss", "burst", "p_good_to_bad", "p_bad_to_good", "loss_in_good", "loss_in_bad", "seed"});
   rsu_client::LinkConfig link;
   for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     const std::string full = where + "." + key;
     const YAML::Node& v = entry.second;
     if (key == "delay") link.delay = r.inRange(v, full, 0.0, 10.0);
@@ -123,7 +123,7 @@ InputConfig readInput(const YamlReader& r, const std::string& topic, const YAML:
   InputConfig input;
   bool has_role = false;
   for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     const std::string full = where + "." + key;
     if (key == "role") {
       const std::string role = r.choice(entry.second, full, {"pose", "twist", "ground_truth", "scan", "rsu_fix", "ignore"});
@@ -355,7 +355,7 @@ const char* sectionComment(const std::string& section) {
 void readSection(const YamlReader& r, const std::string& section, const YAML::Node& node, Config& config) {
   r.requireMap(node, section);
   for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     const Key* found = nullptr;
     for (const Key& k : keys())
       if (section == k.section && key == k.key) found = &k;
@@ -373,14 +373,14 @@ Config parseConfig(const std::string& yaml_text, const std::string& source_name)
   if (root.IsNull()) return config;
   r.requireMap(root, "(top level)");
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     if (key == "fusion") {
       readFusion(r, entry.second, config.fusion);
     } else if (key == "inputs") {
       if (entry.second.IsNull()) continue;
       r.requireMap(entry.second, "inputs");
       for (const auto& input : entry.second) {
-        const std::string topic = input.first.as<std::string>();
+        const std::string topic = r.key(input.first);
         config.inputs[topic] = readInput(r, topic, input.second);
       }
     } else if (std::find(std::begin(kSections), std::end(kSections), key) != std::end(kSections)) {

@@ -21,6 +21,7 @@
 #include "coloc/core/error.hpp"
 #include "coloc/core/types.hpp"
 #include "dds_participant.hpp"
+#include "fix_sample.hpp"
 
 namespace coloc::rsu_client {
 
@@ -99,23 +100,7 @@ struct FixSubscriber::Impl : public dds::DataReaderListener {
     while (reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       const Stamp received = systemNow();
-      RsuFix fix;
-      fix.rsu_id = rsu_id;
-      fix.stamp = stampOf(msg.header());
-      fix.x = msg.pose().pose().position().x();
-      fix.y = msg.pose().pose().position().y();
-      // A yaw is present only if the sender gave it a finite variance.
-      const double yaw_variance = msg.pose().covariance()[35];
-      if (std::isfinite(yaw_variance) && yaw_variance > 0.0) {
-        const auto& q = msg.pose().pose().orientation();
-        fix.yaw = rollPitchYaw(Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()))[2];
-      }
-      // What the message said beside the position, for the checker to hold against the registry.
-      SentFields sent;
-      sent.frame_id = msg.header().frame_id();
-      sent.nanosec = msg.header().stamp().nanosec();
-      for (int i = 0; i < 36; ++i) sent.covariance(i / 6, i % 6) = msg.pose().covariance()[i];
-      fix.sent = std::move(sent);
+      const RsuFix fix = fixFromSample(msg, rsu_id);
       callback(fix, received);
     }
   }

@@ -34,7 +34,7 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
   bool has_position = false, has_model = false;
   std::optional<double> radius;
   for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     const std::string full = where + "." + key;
     if (key == "id") {
       rsu.id = r.text(entry.second, full);
@@ -62,7 +62,7 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
       r.allowKeys(entry.second, full, {"dx", "dy", "dyaw_deg", "clock_offset_ms"});
       RsuCalibrationEntry c;
       for (const auto& e : entry.second) {
-        const std::string k = e.first.as<std::string>();
+        const std::string k = r.key(e.first);
         const std::string kk = full + "." + k;
         if (k == "dx") c.dx = r.inRange(e.second, kk, -10.0, 10.0);
         else if (k == "dy") c.dy = r.inRange(e.second, kk, -10.0, 10.0);
@@ -92,7 +92,7 @@ RsuRegistry RsuRegistry::parse(const std::string& yaml_text, const std::string& 
   if (!root.IsMap()) r.fail(root, "(top level)", "expected a mapping with covariance_placement and rsus");
   std::set<std::string> ids;
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     if (key == "covariance_placement") {
       registry.placement_ = r.choice(entry.second, key, {"published", "standard_deviation"}) == "published"
                                 ? CovariancePlacement::kPublished

@@ -42,7 +42,7 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
   if (root.IsNull()) return c;
   if (!root.IsMap()) r.fail(root, "(file)", "expected a mapping of keys to values");
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = r.key(entry.first);
     const YAML::Node& v = entry.second;
     if (key == "sites") c.sites = r.textList(v, key);
     else if (key == "trials") c.trials = static_cast<int>(r.integer(v, key, 1, 1000));

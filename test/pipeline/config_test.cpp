@@ -100,6 +100,18 @@ TEST(Config, WrongTypesAndRangesAreErrorsNamingTheKey) {
   expectError("fusion:\n  a: [\n", "not valid YAML");
 }
 
+// Found by fuzzing (config_fuzzer): YAML allows a list or a mapping as a key ("? [a, b]"), and reading
+// it as text threw yaml-cpp's own exception past every caller.
+TEST(Config, AKeyThatIsAListOrAMappingIsAnErrorNamingItsLine) {
+  expectError("? [a, b]\n: 1\n", "test.yaml:1: (a key): a key must be plain text");
+  expectError("fusion:\n  ? {a: 1}\n  : 2\n", "test.yaml:2: (a key): a key must be plain text");
+  expectError("inputs:\n  ? [/odom]\n  : {role: twist}\n", "a key must be plain text");
+  // The fuzzer's own input: the shipped configuration with a complex key in its ndt section.
+  const std::string found = readFile(COLOC_SOURCE_DIR "/test/support/fuzz_findings/config_complex_key.bin");
+  ASSERT_FALSE(found.empty());
+  expectError(found.substr(1), "a key must be plain text");
+}
+
 TEST(Config, TwoInputsWithOneSourceNameAreAnError) {
   expectError("inputs:\n  /a: {role: pose, source: x}\n  /b: {role: pose, source: x}\n", "used by two inputs");
 }

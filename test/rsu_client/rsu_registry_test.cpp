@@ -58,6 +58,8 @@ TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
               "rsus[0].calibrated_variance: must be a finite number > 0");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: .nan}\n", "rsus[0].calibrated_variance: must not be NaN");
   expectError("rsu:\n  - {}\n", "rsu: unknown key");
+  expectError("? [rsus]\n: []\n", "a key must be plain text");  // found by fuzzing the configs
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibration: {? [dx] : 1}}\n", "a key must be plain text");
   expectError("map_frame: \"\"\n", "map_frame: '': a frame name");
   expectError("map_frame: \"a b\"\n", "map_frame: 'a b': a frame name");
 }

@@ -47,6 +47,8 @@ class YamlReader {
   std::vector<std::string> textList(const YAML::Node& node, const std::string& key) const;
 
   void requireMap(const YAML::Node& node, const std::string& key) const;
+  /// A mapping's key as text; a key that is a list or a mapping (YAML allows them) fails, with its line.
+  std::string key(const YAML::Node& key_node) const;
   /// Fails on the first key of the mapping `node` that is not in `allowed`, listing the allowed ones.
   void allowKeys(const YAML::Node& node, const std::string& where, std::initializer_list<const char*> allowed) const;
   /// The child `key` of `node`, which must be there.
