@@ -25,11 +25,10 @@ class ExposedNdt : public pcl::NormalDistributionsTransform<PclPoint, PclPoint> 
 struct NdtTarget::Impl {
   NdtConfig config;
   ScoreConstants constants;
-  PclCloud::Ptr cloud;
+  PclCloud::Ptr cloud;  ///< the stock backend's input (the fast backend needs no PCL copy)
+  std::size_t point_count = 0;  ///< finite map points the target was built from
   /// The stock backend aligns with this object; its voxel grid also feeds `voxels`.
   std::shared_ptr<ExposedNdt> pcl_ndt;
-  /// The fast backend's grid (no k-d tree: it is never searched by radius).
-  std::shared_ptr<pcl::VoxelGridCovariance<PclPoint>> grid;
   VoxelLookup voxels;
 };
 

@@ -1,7 +1,8 @@
 #pragma once
 // Direct lookup of NDT voxels by integer voxel coordinates: an open-addressing hash over the usable
-// leaves of a pcl::VoxelGridCovariance, with each voxel's mean and inverse covariance stored
-// contiguously. Replaces the k-d tree radius search PCL's NDT does for every point and iteration.
+// voxels (built by voxel_grid.hpp, or copied from PCL's grid for the stock backend), with each voxel's
+// mean and inverse covariance stored contiguously. Replaces the k-d tree radius search PCL's NDT does
+// for every point and iteration.
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -33,14 +34,11 @@ class VoxelLookup {
   std::size_t size() const { return voxels_.size(); }
   const std::vector<Voxel>& voxels() const { return voxels_; }
 
- private:
-  struct Slot {
-    std::uint64_t key = 0;
-    std::int64_t voxel = -1;
-  };
+  /// Voxel coordinates must be within (-kMaxCoordinate, kMaxCoordinate) on each axis.
+  static constexpr int kMaxCoordinate = 1 << 20;
   static std::uint64_t pack(const Eigen::Vector3i& c) {
     // 21 bits per axis with an offset: +-1e6 voxels, i.e. +-2000 km at 2 m resolution.
-    constexpr std::int64_t kOffset = 1 << 20;
+    constexpr std::int64_t kOffset = kMaxCoordinate;
     return (static_cast<std::uint64_t>(c.x() + kOffset) << 42) | (static_cast<std::uint64_t>(c.y() + kOffset) << 21) |
            static_cast<std::uint64_t>(c.z() + kOffset);
   }
@@ -50,6 +48,12 @@ class VoxelLookup {
     key ^= key >> 33;
     return key;
   }
+
+ private:
+  struct Slot {
+    std::uint64_t key = 0;
+    std::int64_t voxel = -1;
+  };
 
   std::vector<Voxel> voxels_;
   std::vector<Eigen::Vector3i> coordinates_;

@@ -165,7 +165,7 @@ const std::vector<Key>& keys() {
   using namespace coloc::ndt;
   static const std::vector<Key> table = {
       // ---- ndt: types here; ranges are ndt's own checks (ndt::validate)
-      {"ndt", "backend", "", "pcl (stock pcl::NormalDistributionsTransform) or fast (coloc's aligner on PCL's voxel grid)",
+      {"ndt", "backend", "", "pcl (stock pcl::NormalDistributionsTransform) or fast (coloc's aligner on a hashed voxel grid with PCL's voxel statistics)",
        [](const C& c) { return S(c.ndt.source.ndt.backend == NdtBackend::kPcl ? "pcl" : "fast"); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.backend = r.choice(n, k, {"pcl", "fast"}) == "pcl" ? NdtBackend::kPcl : NdtBackend::kFast; }},
       {"ndt", "neighborhood", "", "fast backend voxels per point: radius (as PCL), face7 or single",

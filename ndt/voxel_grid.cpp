@@ -1,0 +1,171 @@
+#include "voxel_grid.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <exception>
+#include <thread>
+#include <utility>
+
+#include "coloc/core/error.hpp"
+
+namespace coloc::ndt {
+
+namespace {
+
+constexpr int kMinPointsPerVoxel = 6;          // PCL's VoxelGridCovariance default
+constexpr double kMinCovarianceEigenRatio = 0.01;  // its min_covar_eigvalue_mult_
+
+// A voxel's running sums; the outer products keep their 6 distinct entries (xx xy xz yy yz zz), each
+// summed in point order as PCL sums the full matrix.
+struct Sums {
+  Eigen::Vector3i ijk;
+  int n = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+};
+
+// Open addressing from a voxel's packed coordinates to its sums. It starts small and doubles: a map
+// has far fewer voxels than points, and a table that stays in cache is what makes the pass fast.
+class SumTable {
+ public:
+  SumTable() : slots_(4096), mask_(4095) {}
+  Sums& at(std::uint64_t key, const Eigen::Vector3i& ijk) {
+    for (std::size_t i = VoxelLookup::hash(key) & mask_;; i = (i + 1) & mask_) {
+      if (slots_[i].key == key) return sums_[slots_[i].index];
+      if (slots_[i].key == kEmpty) {
+        if (2 * (sums_.size() + 1) > slots_.size()) {
+          grow();
+          i = place(key);
+        }
+        slots_[i] = {key, sums_.size()};
+        sums_.push_back(Sums{ijk});
+        return sums_.back();
+      }
+    }
+  }
+  const std::vector<Sums>& sums() const { return sums_; }
+
+ private:
+  static constexpr std::uint64_t kEmpty = std::numeric_limits<std::uint64_t>::max();  // no packed key has all bits set
+  struct Slot {
+    std::uint64_t key = kEmpty;
+    std::size_t index = 0;
+  };
+  std::size_t place(std::uint64_t key) const {
+    std::size_t i = VoxelLookup::hash(key) & mask_;
+    while (slots_[i].key != kEmpty) i = (i + 1) & mask_;
+    return i;
+  }
+  void grow() {
+    std::vector<Slot> old(slots_.size() * 2);
+    old.swap(slots_);
+    mask_ = slots_.size() - 1;
+    for (const Slot& s : old)
+      if (s.key != kEmpty) slots_[place(s.key)] = s;
+  }
+  std::vector<Slot> slots_;
+  std::size_t mask_;
+  std::vector<Sums> sums_;
+};
+
+// A voxel's mean and inverse covariance as PCL computes them; false for a voxel PCL leaves out.
+bool statistics(const Sums& s, Voxel& voxel) {
+  if (s.n < kMinPointsPerVoxel) return false;
+  // PCL's single-pass covariance: (sum x x^T - sum x mean^T) / (n - 1).
+  const Eigen::Vector3d mean = s.sum / s.n;
+  Eigen::Matrix3d outer;
+  outer << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
+  Eigen::Matrix3d covariance = (outer - s.sum * mean.transpose()) / (s.n - 1.0);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::Matrix3d values = solver.eigenvalues().asDiagonal();
+  const Eigen::Matrix3d vectors = solver.eigenvectors();
+  if (values(0, 0) < -Eigen::NumTraits<double>::dummy_precision() || values(1, 1) < -Eigen::NumTraits<double>::dummy_precision() ||
+      values(2, 2) <= 0)
+    return false;  // degenerate: PCL drops it
+  // Flat and linear voxels are thickened (Magnusson 2009, eq. 6.11) so that they can be inverted.
+  const double floor_value = kMinCovarianceEigenRatio * values(2, 2);
+  if (values(0, 0) < floor_value) {
+    values(0, 0) = floor_value;
+    if (values(1, 1) < floor_value) values(1, 1) = floor_value;
+    covariance = vectors * values * vectors.inverse();
+  }
+  const Eigen::Matrix3d inverse_covariance = covariance.inverse();
+  if (inverse_covariance.maxCoeff() == std::numeric_limits<float>::infinity() ||
+      inverse_covariance.minCoeff() == -std::numeric_limits<float>::infinity())
+    return false;
+  voxel = {mean, inverse_covariance};
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+// One thread's share: the voxels whose hash falls in `part` of `parts`, with their points summed in
+// point order (so that each voxel's sums are PCL's, bit for bit), then their statistics.
+void buildPart(const std::vector<Eigen::Vector3f>& points, float leaf, unsigned part, unsigned parts,
+               std::vector<std::pair<Eigen::Vector3i, Voxel>>& out) {
+  // PCL: ijk = floor(p * (1 / leaf)), all in float.
+  const float inverse = 1.0f / leaf;
+  SumTable table;
+  for (const Eigen::Vector3f& p : points) {
+    if (!p.allFinite()) continue;  // as PCL's grid never sees them (toPcl leaves them out)
+    const Eigen::Vector3f scaled = p * inverse;
+    // Checked before the conversion to int, which would be undefined for a value out of its range.
+    if (!(scaled.array().abs() < static_cast<float>(VoxelLookup::kMaxCoordinate - 1)).all())
+      throw Error("NDT target: a map point at (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) +
+                  ") lies beyond the voxels a " + std::to_string(leaf) + " m grid can address; re-centre the map");
+    const Eigen::Vector3i ijk(static_cast<int>(std::floor(scaled.x())), static_cast<int>(std::floor(scaled.y())),
+                              static_cast<int>(std::floor(scaled.z())));
+    const std::uint64_t key = VoxelLookup::pack(ijk);
+    if ((VoxelLookup::hash(key) >> 32) % parts != part) continue;
+    Sums& s = table.at(key, ijk);
+    const Eigen::Vector3d q = p.cast<double>();
+    s.sum += q;
+    s.xx += q.x() * q.x();
+    s.xy += q.x() * q.y();
+    s.xz += q.x() * q.z();
+    s.yy += q.y() * q.y();
+    s.yz += q.y() * q.z();
+    s.zz += q.z() * q.z();
+    ++s.n;
+  }
+  out.reserve(table.sums().size());
+  Voxel voxel;
+  for (const Sums& s : table.sums())
+    if (statistics(s, voxel)) out.emplace_back(s.ijk, voxel);
+}
+
+}  // namespace
+
+void buildVoxels(const std::vector<Eigen::Vector3f>& points, float leaf, VoxelLookup& out) {
+  // Two threads, each owning half of the voxels: the pass over the points is bound by cache misses
+  // into the sums, and each thread's table is half the size.
+  constexpr unsigned kParts = 2;
+  std::vector<std::pair<Eigen::Vector3i, Voxel>> voxels[kParts];
+  std::exception_ptr failure;
+  std::thread other([&] {
+    try {
+      buildPart(points, leaf, 1, kParts, voxels[1]);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  });
+  try {
+    buildPart(points, leaf, 0, kParts, voxels[0]);
+  } catch (...) {
+    other.join();
+    throw;
+  }
+  other.join();
+  if (failure) std::rethrow_exception(failure);
+  out.reserve(voxels[0].size() + voxels[1].size());
+  for (const auto& part : voxels)
+    for (const auto& [ijk, voxel] : part) out.insert(ijk, voxel);
+  out.finish();
+}
+
+}  // namespace coloc::ndt
