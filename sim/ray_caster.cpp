@@ -2,7 +2,10 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cstring>
+#include <functional>
+#include <thread>
 #include <limits>
 #include <string>
 
@@ -80,10 +83,69 @@ void RayCaster::commit() {
   impl_->committed = true;
 }
 
+namespace {
+
+void checkCast(bool committed, std::size_t origins, std::size_t directions) {
+  if (!committed) throw Error("ray casting: commit() the scene before casting");
+  if (origins != directions) throw Error("ray casting: origins and directions differ in number");
+}
+
+// Rays [from, to) in packets of 8; a short last packet has its unused lanes masked off.
+void castPackets(RTCScene scene, const std::vector<Eigen::Vector3f>& origins, const std::vector<Eigen::Vector3f>& directions, float max_range,
+                 std::vector<RayHit>& hits, std::size_t from, std::size_t to) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  for (std::size_t i = from; i < to; i += 8) {
+    const std::size_t n = std::min<std::size_t>(8, to - i);
+    alignas(32) int valid[8];
+    RTCRayHit8 rh;
+    for (std::size_t k = 0; k < 8; ++k) {
+      const std::size_t r = i + std::min(k, n - 1);  // unused lanes repeat the last ray, masked off
+      valid[k] = k < n ? -1 : 0;
+      rh.ray.org_x[k] = origins[r].x();
+      rh.ray.org_y[k] = origins[r].y();
+      rh.ray.org_z[k] = origins[r].z();
+      rh.ray.dir_x[k] = directions[r].x();
+      rh.ray.dir_y[k] = directions[r].y();
+      rh.ray.dir_z[k] = directions[r].z();
+      rh.ray.tnear[k] = 0.0f;
+      rh.ray.tfar[k] = max_range;
+      rh.ray.time[k] = 0.0f;
+      rh.ray.mask[k] = std::numeric_limits<unsigned>::max();
+      rh.ray.id[k] = 0;
+      rh.ray.flags[k] = 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, scene, &context, &rh);
+    for (std::size_t k = 0; k < n; ++k)
+      if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) hits[i + k] = {rh.ray.tfar[k], static_cast<int>(rh.hit.geomID[k])};
+  }
+}
+
+}  // namespace
+
 void RayCaster::cast(const std::vector<Eigen::Vector3f>& origins, const std::vector<Eigen::Vector3f>& directions, float max_range,
                      std::vector<RayHit>& hits) const {
-  if (!impl_->committed) throw Error("ray casting: commit() the scene before casting");
-  if (origins.size() != directions.size()) throw Error("ray casting: origins and directions differ in number");
+  checkCast(impl_->committed, origins.size(), directions.size());
+  hits.assign(origins.size(), RayHit{});
+  // One contiguous share per core (neighbouring rays stay together in packets); a few rays are not
+  // worth a thread.
+  const std::size_t threads = origins.size() < 4096 ? 1 : std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+  const std::size_t share = (origins.size() / threads + 7) / 8 * 8;
+  std::vector<std::size_t> bounds(threads + 1, origins.size());
+  for (std::size_t t = 0; t < threads; ++t) bounds[t] = std::min(origins.size(), t * share);
+  std::vector<std::thread> workers;
+  for (std::size_t t = 1; t < threads; ++t)
+    workers.emplace_back(castPackets, impl_->scene, std::cref(origins), std::cref(directions), max_range, std::ref(hits), bounds[t], bounds[t + 1]);
+  castPackets(impl_->scene, origins, directions, max_range, hits, bounds[0], bounds[1]);
+  for (std::thread& w : workers) w.join();
+}
+
+void RayCaster::castOneByOne(const std::vector<Eigen::Vector3f>& origins, const std::vector<Eigen::Vector3f>& directions, float max_range,
+                             std::vector<RayHit>& hits) const {
+  checkCast(impl_->committed, origins.size(), directions.size());
   hits.assign(origins.size(), RayHit{});
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "coloc/core/error.hpp"
 #include "coloc/sim/ray_caster.hpp"
+#include "street_scene.hpp"
 
 namespace coloc::sim {
 namespace {
@@ -29,6 +32,27 @@ TEST(RayCaster, MovedMeshIsHitWhereItIsNow) {
   std::vector<RayHit> hits;
   world.cast({{0, 0, 0.5f}}, {{1, 0, 0}}, 50.0f, hits);
   EXPECT_NEAR(hits[0].distance, 8.0f - 2.25f, 1e-4f);
+}
+
+// A street of houses, trees and cars seen by a 32-beam LiDAR from a moving vehicle: the packet cast on
+// every core gives the one-ray-at-a-time cast's hits, ray for ray.
+TEST(RayCaster, PacketsOnEveryCoreHitWhatOneRayAtATimeHits) {
+  RayCaster world;
+  std::vector<Eigen::Vector3f> origins, directions;
+  testing::buildStreet(world, origins, directions);
+  origins.resize(origins.size() - 5);  // a last packet that is not full
+  directions.resize(origins.size());
+  std::vector<RayHit> packets, reference;
+  world.cast(origins, directions, 120.0f, packets);
+  world.castOneByOne(origins, directions, 120.0f, reference);
+  ASSERT_EQ(packets.size(), reference.size());
+  std::size_t hit = 0, differing = 0;
+  for (std::size_t i = 0; i < packets.size(); ++i) {
+    hit += reference[i].mesh >= 0;
+    differing += packets[i].mesh != reference[i].mesh || std::abs(packets[i].distance - reference[i].distance) > 1e-5f;
+  }
+  EXPECT_GT(hit, packets.size() / 2);
+  EXPECT_EQ(differing, 0u) << "of " << packets.size() << " rays";
 }
 
 TEST(RayCaster, MisuseIsAnError) {

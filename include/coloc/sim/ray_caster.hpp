@@ -27,9 +27,13 @@ class RayCaster {
   void updateMesh(int id, const TriangleMesh& mesh);
   void commit();
 
-  /// Casts rays (unit directions) from their origins; thread-safe once committed.
+  /// Casts rays (unit directions) from their origins; thread-safe once committed. Packets of 8
+  /// neighbouring rays (a LiDAR's rays are coherent) on every core; the hits are castOneByOne's.
   void cast(const std::vector<Eigen::Vector3f>& origins, const std::vector<Eigen::Vector3f>& directions, float max_range,
             std::vector<RayHit>& hits) const;
+  /// The same, one ray at a time on the calling thread: the reference cast() is tested and measured against.
+  void castOneByOne(const std::vector<Eigen::Vector3f>& origins, const std::vector<Eigen::Vector3f>& directions, float max_range,
+                    std::vector<RayHit>& hits) const;
 
   std::size_t triangleCount() const;
 
