@@ -4,7 +4,8 @@
 #include <cmath>
 #include <numeric>
 #include <random>
-#include <unordered_map>
+
+#include "voxel_index.hpp"
 
 namespace coloc::ndt {
 
@@ -51,19 +52,18 @@ PointCloud voxelDownsample(const PointCloud& cloud, double voxel_size) {
     double time = 0.0;
     int count = 0;
   };
-  std::unordered_map<std::uint64_t, std::size_t> index;
+  VoxelIndex index;
   std::vector<Sum> sums;
-  index.reserve(cloud.size());
   const double inverse = 1.0 / voxel_size;
   const bool times = cloud.hasTimes();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d p = cloud.points[i].cast<double>();
-    const Eigen::Vector3i c = (p * inverse).array().floor().cast<int>();
-    const std::uint64_t key = (static_cast<std::uint64_t>(c.x() + (1 << 20)) << 42) |
-                              (static_cast<std::uint64_t>(c.y() + (1 << 20)) << 21) | static_cast<std::uint64_t>(c.z() + (1 << 20));
-    auto [it, inserted] = index.try_emplace(key, sums.size());
+    const Eigen::Array3d scaled = (p * inverse).array().floor();
+    // A point that is not finite, or too far out for integer voxel coordinates, has no voxel.
+    if (!(scaled.abs() < 2e9).all()) continue;
+    const auto [at, inserted] = index.insert({static_cast<std::int32_t>(scaled.x()), static_cast<std::int32_t>(scaled.y()), static_cast<std::int32_t>(scaled.z())});
     if (inserted) sums.emplace_back();
-    Sum& s = sums[it->second];
+    Sum& s = sums[at];
     s.point += p;
     if (times) s.time += cloud.times[i];
     ++s.count;

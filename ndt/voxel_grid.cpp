@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "coloc/core/error.hpp"
+#include "voxel_index.hpp"
 
 namespace coloc::ndt {
 
@@ -25,50 +26,6 @@ struct Sums {
   int n = 0;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-};
-
-// Open addressing from a voxel's packed coordinates to its sums. It starts small and doubles: a map
-// has far fewer voxels than points, and a table that stays in cache is what makes the pass fast.
-class SumTable {
- public:
-  SumTable() : slots_(4096), mask_(4095) {}
-  Sums& at(std::uint64_t key, const Eigen::Vector3i& ijk) {
-    for (std::size_t i = VoxelLookup::hash(key) & mask_;; i = (i + 1) & mask_) {
-      if (slots_[i].key == key) return sums_[slots_[i].index];
-      if (slots_[i].key == kEmpty) {
-        if (2 * (sums_.size() + 1) > slots_.size()) {
-          grow();
-          i = place(key);
-        }
-        slots_[i] = {key, sums_.size()};
-        sums_.push_back(Sums{ijk});
-        return sums_.back();
-      }
-    }
-  }
-  const std::vector<Sums>& sums() const { return sums_; }
-
- private:
-  static constexpr std::uint64_t kEmpty = std::numeric_limits<std::uint64_t>::max();  // no packed key has all bits set
-  struct Slot {
-    std::uint64_t key = kEmpty;
-    std::size_t index = 0;
-  };
-  std::size_t place(std::uint64_t key) const {
-    std::size_t i = VoxelLookup::hash(key) & mask_;
-    while (slots_[i].key != kEmpty) i = (i + 1) & mask_;
-    return i;
-  }
-  void grow() {
-    std::vector<Slot> old(slots_.size() * 2);
-    old.swap(slots_);
-    mask_ = slots_.size() - 1;
-    for (const Slot& s : old)
-      if (s.key != kEmpty) slots_[place(s.key)] = s;
-  }
-  std::vector<Slot> slots_;
-  std::size_t mask_;
-  std::vector<Sums> sums_;
 };
 
 // A voxel's mean and inverse covariance as PCL computes them; false for a voxel PCL leaves out.
@@ -110,7 +67,8 @@ void buildPart(const std::vector<Eigen::Vector3f>& points, float leaf, unsigned 
                std::vector<std::pair<Eigen::Vector3i, Voxel>>& out) {
   // PCL: ijk = floor(p * (1 / leaf)), all in float.
   const float inverse = 1.0f / leaf;
-  SumTable table;
+  PackedVoxelIndex index;
+  std::vector<Sums> sums;
   for (const Eigen::Vector3f& p : points) {
     if (!p.allFinite()) continue;  // as PCL's grid never sees them (toPcl leaves them out)
     const Eigen::Vector3f scaled = p * inverse;
@@ -122,7 +80,9 @@ void buildPart(const std::vector<Eigen::Vector3f>& points, float leaf, unsigned 
                               static_cast<int>(std::floor(scaled.z())));
     const std::uint64_t key = VoxelLookup::pack(ijk);
     if ((VoxelLookup::hash(key) >> 32) % parts != part) continue;
-    Sums& s = table.at(key, ijk);
+    const auto [at, added] = index.insert(key);
+    if (added) sums.push_back(Sums{ijk});
+    Sums& s = sums[at];
     const Eigen::Vector3d q = p.cast<double>();
     s.sum += q;
     s.xx += q.x() * q.x();
@@ -133,9 +93,9 @@ void buildPart(const std::vector<Eigen::Vector3f>& points, float leaf, unsigned 
     s.zz += q.z() * q.z();
     ++s.n;
   }
-  out.reserve(table.sums().size());
+  out.reserve(sums.size());
   Voxel voxel;
-  for (const Sums& s : table.sums())
+  for (const Sums& s : sums)
     if (statistics(s, voxel)) out.emplace_back(s.ijk, voxel);
 }
 

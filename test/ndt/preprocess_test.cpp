@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "coloc/ndt/preprocess.hpp"
 
@@ -15,6 +16,21 @@ TEST(Preprocess, VoxelDownsampleKeepsOneCentroidPerVoxel) {
   EXPECT_TRUE(out.points[0].isApprox(Eigen::Vector3f(0.2f, 0.3f, 0.1f)));  // first two share a voxel
   EXPECT_TRUE(out.points[1].isApprox(Eigen::Vector3f(1.5f, 0.2f, 0.2f)));
   EXPECT_TRUE(out.points[2].isApprox(Eigen::Vector3f(-0.5f, 0.0f, 0.0f)));  // negative side is its own voxel
+}
+
+// Voxel coordinates beyond 2^20 on an axis (a map in projected coordinates at a fine voxel) were once
+// packed 21 bits an axis into one key, and voxels far apart could share it: these two did. And points
+// that are not finite have no voxel.
+TEST(Preprocess, VoxelDownsampleKeepsFarApartVoxelsApartAndLeavesOutNonFinitePoints) {
+  PointCloud cloud;
+  const float nan = std::nanf("");
+  cloud.points = {{0.05f, 0.05f, 104857.65f}, {nan, 0.0f, 0.0f}, {0.05f, 0.15f, -104857.55f},
+                  {0.0f, std::numeric_limits<float>::infinity(), 0.0f}, {0.07f, 0.05f, 104857.65f}};
+  const PointCloud out = voxelDownsample(cloud, 0.1);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out.points[0].z(), 104857.65, 0.01);
+  EXPECT_NEAR(out.points[1].z(), -104857.55, 0.01);
+  for (const auto& p : out.points) EXPECT_TRUE(p.allFinite());
 }
 
 TEST(Preprocess, CapTakesARepeatableSubsetOfTheRequestedSize) {

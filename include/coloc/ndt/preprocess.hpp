@@ -24,7 +24,8 @@ PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range
 PointCloud deskew(const PointCloud& cloud, double vx, double wz);
 
 /// One point per occupied voxel: the centroid of its points. Output order follows first appearance,
-/// so the result does not depend on hashing.
+/// so the result does not depend on hashing. Points that are not finite (or beyond 2e9 voxels) have no
+/// voxel and are left out.
 PointCloud voxelDownsample(const PointCloud& cloud, double voxel_size);
 
 /// At most `max_points` points, a random subset drawn with `seed` (deterministic).
