@@ -10,6 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string path = coloc::fuzz::inputFile(data, size, COLOC_FUZZ_BAG_FILE);
   try {
     coloc::io::BagReader reader = coloc::io::BagReader::open(path);
+    reader.keepAttachments(true);
     coloc::io::BagMessage message;
     while (reader.next(message)) {
     }

@@ -52,6 +52,7 @@ void removePartialOutput(const std::string& output, bool is_mcap, bool directory
 
 ConvertSummary convert(const std::string& input, const std::string& output, const ConvertOptions& options) {
   BagReader reader = BagReader::open(input);
+  reader.keepAttachments(true);  // copied to an MCAP output, counted for a sqlite3 one
   ConvertSummary summary;
   summary.topics = reader.topics();
   const bool is_mcap = endsWith(output, ".mcap");

@@ -253,6 +253,10 @@ const std::string& BagReader::storageIdentifier() const { return impl_->storage;
 const std::vector<std::string>& BagReader::files() const { return impl_->files; }
 const std::vector<TopicInfo>& BagReader::topics() const { return impl_->topics; }
 std::uint64_t BagReader::messageCount() const { return impl_->message_count; }
+void BagReader::keepAttachments(bool keep) {
+  for (auto& reader : impl_->readers)
+    if (reader) reader->keepAttachments(keep);
+}
 const std::vector<BagAttachment>& BagReader::attachments() const { return impl_->attachments; }
 const std::vector<BagMetadataRecord>& BagReader::metadataRecords() const { return impl_->metadata; }
 

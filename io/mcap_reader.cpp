@@ -60,6 +60,7 @@ class McapReader final : public StorageReader {
   explicit McapReader(const std::string& path);
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   bool next(BagMessage& message) override;
+  void keepAttachments(bool keep) override { keep_attachments_ = keep; }
   std::vector<BagAttachment> takeAttachments() override { return std::move(attachments_); }
   std::vector<BagMetadataRecord> takeMetadata() override { return std::move(metadata_); }
 
@@ -100,6 +101,7 @@ class McapReader final : public StorageReader {
   std::map<std::uint16_t, ChannelRecord> channels_;
   std::vector<TopicInfo> topics_;
   std::map<std::uint16_t, std::size_t> topic_of_channel_;
+  bool keep_attachments_ = false;
   std::vector<BagAttachment> attachments_;  // met in the data section, for conversion
   std::vector<BagMetadataRecord> metadata_;
 
@@ -345,6 +347,7 @@ bool McapReader::next(BagMessage& message) {
       }
       case kAttachment:
       case kMetadata: {
+        if (!keep_attachments_) break;  // a replay has no use for them: not even read
         loadContent(head);
         RecordCursor cursor(content_.data(), content_.size(), where(head));
         if (head.opcode == kAttachment) attachments_.push_back(parseAttachment(cursor));

@@ -15,6 +15,8 @@ class StorageReader {
   virtual const std::vector<TopicInfo>& topics() const = 0;
   /// Next message in file order; false at the end. message.index is left to the caller.
   virtual bool next(BagMessage& message) = 0;
+  /// Whether next() collects attachments and metadata records (off: skipped unread).
+  virtual void keepAttachments(bool) {}
   /// Attachments and metadata records met by next() so far (all of them once it returned false).
   virtual std::vector<BagAttachment> takeAttachments() { return {}; }
   virtual std::vector<BagMetadataRecord> takeMetadata() { return {}; }

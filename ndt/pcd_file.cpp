@@ -192,7 +192,7 @@ PointCloud loadPcd(const std::string& path, PcdLoadReport* report) {
         if (&f == wanted[k]) break;
         column[k] += static_cast<std::size_t>(f.count);
       }
-    std::istringstream in(bytes.substr(h.data_start));
+    std::istringstream in(bytes.substr(std::min(bytes.size(), h.data_start)));  // a header may end the file
     std::string line;
     std::size_t read = 0;
     while (read < n && std::getline(in, line)) {

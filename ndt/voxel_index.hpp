@@ -78,7 +78,7 @@ struct VoxelCoordinatesHash {
 };
 using VoxelIndex = DenseIndex<VoxelCoordinates, VoxelCoordinatesHash>;
 
-/// Voxel coordinates packed into 64 bits (VoxelLookup::pack).
+/// Voxel coordinates packed into 64 bits (VoxelLookup::pack, whose table hashes them the same way).
 struct PackedVoxelHash {
   std::size_t operator()(std::uint64_t key) const { return static_cast<std::size_t>(mixBits(key)); }
 };

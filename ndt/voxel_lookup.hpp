@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "voxel_index.hpp"
+
 namespace coloc::ndt {
 
 struct Voxel {
@@ -42,12 +44,7 @@ class VoxelLookup {
     return (static_cast<std::uint64_t>(c.x() + kOffset) << 42) | (static_cast<std::uint64_t>(c.y() + kOffset) << 21) |
            static_cast<std::uint64_t>(c.z() + kOffset);
   }
-  static std::uint64_t hash(std::uint64_t key) {
-    key ^= key >> 33;
-    key *= 0xff51afd7ed558ccdULL;
-    key ^= key >> 33;
-    return key;
-  }
+  static std::uint64_t hash(std::uint64_t key) { return mixBits(key); }
 
  private:
   struct Slot {

@@ -4,28 +4,11 @@
 
 namespace coloc::pipeline {
 
-void SpeedScaleEstimator::addTwist(Stamp stamp, double vx) {
-  if (!std::isfinite(vx)) return;
-  if (!marks_.empty() && stamp <= marks_.back().stamp) return;  // out of order: the integral keeps its course
-  const double distance =
-      marks_.empty() ? 0.0 : marks_.back().distance + 0.5 * (std::abs(vx) + std::abs(marks_.back().vx)) * toSeconds(stamp - marks_.back().stamp);
-  marks_.push_back({stamp, vx, distance});
-  while (marks_.size() > 2 && marks_.front().stamp < stamp - 2 * kNanosPerSecond) marks_.pop_front();
-}
-
-double SpeedScaleEstimator::odometryAt(Stamp stamp) const {
-  auto after = marks_.begin();
-  while (after != marks_.end() && after->stamp < stamp) ++after;
-  if (after == marks_.begin()) return marks_.front().distance - std::abs(marks_.front().vx) * toSeconds(marks_.front().stamp - stamp);
-  if (after == marks_.end()) return marks_.back().distance + std::abs(marks_.back().vx) * toSeconds(stamp - marks_.back().stamp);
-  const auto before = after - 1;
-  const double w = static_cast<double>(stamp - before->stamp) / static_cast<double>(after->stamp - before->stamp);
-  return before->distance + w * (after->distance - before->distance);
-}
+void SpeedScaleEstimator::addTwist(Stamp stamp, double vx) { odometry_.add(stamp, std::abs(vx)); }
 
 void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position) {
-  if (!config_.enabled || marks_.empty() || !position.allFinite()) return;
-  const double odometry = odometryAt(stamp);
+  if (!config_.enabled || odometry_.empty() || !position.allFinite()) return;
+  const double odometry = odometry_.at(stamp);
   if (!anchor_) {
     anchor_ = {position, odometry};
     return;

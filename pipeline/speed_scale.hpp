@@ -5,11 +5,11 @@
 // takes the factor as a fixed parameter (vehicle_velocity_converter's speed_scale_factor); here it is
 // measured as the ratio of the distance NDT's poses travel to the distance the odometry integrates,
 // over chords of a few metres, with exponential forgetting so that it follows slow changes.
-#include <deque>
 #include <optional>
 
 #include "coloc/core/time.hpp"
 #include "coloc/core/types.hpp"
+#include "odometry_integral.hpp"
 
 namespace coloc::pipeline {
 
@@ -35,16 +35,8 @@ class SpeedScaleEstimator {
   double comparedDistance() const { return compared_; }
 
  private:
-  double odometryAt(Stamp stamp) const;
-
   SpeedScaleConfig config_;
-  // Integrated odometry distance at each recent twist (trapezoids between them), so that the distance
-  // at a pose's stamp, which lies a sweep and a match in the past, is interpolated, not extrapolated.
-  struct Mark {
-    Stamp stamp;
-    double vx, distance;
-  };
-  std::deque<Mark> marks_;
+  OdometryIntegral odometry_;  ///< distance the odometry claims (integral of |vx|)
   // The pose the current chord starts at.
   std::optional<std::pair<Eigen::Vector2d, double>> anchor_;  ///< position, odometry distance there
   double weighted_pose_ = 0.0, weighted_odometry_ = 0.0;       ///< forgetful sums of chord lengths

@@ -6,10 +6,10 @@
 // between NDT poses. NDT's heading changes are free of it (a LiDAR mounting error cancels in the
 // difference): the bias is the odometry's integrated yaw minus NDT's over windows of a few seconds,
 // per second, with exponential forgetting so that it follows the drift.
-#include <deque>
 #include <optional>
 
 #include "coloc/core/time.hpp"
+#include "odometry_integral.hpp"
 
 namespace coloc::pipeline {
 
@@ -35,14 +35,8 @@ class YawRateBiasEstimator {
   double comparedTime() const { return compared_; }
 
  private:
-  double odometryAt(Stamp stamp) const;
-
   YawRateBiasConfig config_;
-  struct Mark {
-    Stamp stamp;
-    double wz, yaw;  ///< the rate, and the odometry's integrated heading at the stamp
-  };
-  std::deque<Mark> marks_;
+  OdometryIntegral odometry_;  ///< the odometry's heading
   std::optional<std::pair<Stamp, std::pair<double, double>>> anchor_;  ///< stamp, (NDT yaw, odometry yaw)
   double weighted_difference_ = 0.0, weighted_time_ = 0.0;             ///< forgetful sums
   double estimate_ = 0.0, compared_ = 0.0;

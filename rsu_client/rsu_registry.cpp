@@ -99,7 +99,7 @@ RsuRegistry RsuRegistry::parse(const std::string& yaml_text, const std::string& 
                                 : CovariancePlacement::kStandardDeviation;
     } else if (key == "map_frame") {
       registry.map_frame_ = r.text(entry.second, key);
-      bool plain = !registry.map_frame_.empty() && registry.map_frame_.size() <= 256;
+      bool plain = !registry.map_frame_.empty() && registry.map_frame_.size() <= kMaxFrameIdBytes;
       for (char c : registry.map_frame_) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/' || c == '-' || c == '.');
       if (!plain) r.fail(entry.second, key, "'" + registry.map_frame_ + "': a frame name of 1-256 letters, digits, _ / - .");
     } else if (key == "rsus") {

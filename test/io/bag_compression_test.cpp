@@ -44,12 +44,18 @@ void expectSameMessages(const std::vector<BagMessage>& a, const std::vector<BagM
   EXPECT_TRUE(ka == kb);
 }
 
+// The real recording converted to a sqlite3 bag named `name` in `dir`, compressed as asked.
+std::string convertedBag(const ScratchDir& dir, const std::string& name, BagCompression compression) {
+  ConvertOptions options;
+  options.sqlite_compression = compression;
+  const std::string bag = dir / name;
+  convert(nav2Bag(), bag, options);
+  return bag;
+}
+
 TEST(BagCompression, FileModeBagHoldsOnlyTheCompressedDatabaseAndReadsBackEveryMessage) {
   ScratchDir dir;
-  ConvertOptions options;
-  options.sqlite_compression = BagCompression::kZstdFile;
-  const std::string bag = dir / "filemode";
-  convert(nav2Bag(), bag, options);
+  const std::string bag = convertedBag(dir, "filemode", BagCompression::kZstdFile);
   EXPECT_TRUE(fs::is_regular_file(fs::path(bag) / "filemode_0.db3.zstd"));
   EXPECT_FALSE(fs::exists(fs::path(bag) / "filemode_0.db3"));
   const std::string metadata = text((fs::path(bag) / "metadata.yaml").string());
@@ -68,10 +74,7 @@ TEST(BagCompression, FileModeBagHoldsOnlyTheCompressedDatabaseAndReadsBackEveryM
 
 TEST(BagCompression, MessageModeStoresZstdFramesAndReadsBackEveryMessage) {
   ScratchDir dir;
-  ConvertOptions options;
-  options.sqlite_compression = BagCompression::kZstdMessage;
-  const std::string bag = dir / "messagemode";
-  convert(nav2Bag(), bag, options);
+  const std::string bag = convertedBag(dir, "messagemode", BagCompression::kZstdMessage);
   const std::string metadata = text((fs::path(bag) / "metadata.yaml").string());
   EXPECT_NE(metadata.find("compression_mode: \"MESSAGE\""), std::string::npos) << metadata;
   // The database alone, read without the metadata, gives the frames as stored: zstd's magic first.
@@ -87,10 +90,7 @@ TEST(BagCompression, MessageModeStoresZstdFramesAndReadsBackEveryMessage) {
 
 TEST(BagCompression, DamagedCompressedDataIsRefusedWithTheFileAndTheReason) {
   ScratchDir dir;
-  ConvertOptions options;
-  options.sqlite_compression = BagCompression::kZstdFile;
-  const std::string bag = dir / "cut";
-  convert(nav2Bag(), bag, options);
+  const std::string bag = convertedBag(dir, "cut", BagCompression::kZstdFile);
   const std::string file = (fs::path(bag) / "cut_0.db3.zstd").string();
   std::vector<std::uint8_t> bytes = readBytes(file);
   bytes.resize(bytes.size() / 2);
@@ -104,9 +104,7 @@ TEST(BagCompression, DamagedCompressedDataIsRefusedWithTheFileAndTheReason) {
   EXPECT_NE(error.find("not a valid zstd file"), std::string::npos) << error;
 
   // MESSAGE mode: a message that is not a zstd frame names its position and topic.
-  options.sqlite_compression = BagCompression::kNone;
-  const std::string plain = dir / "plain";
-  convert(nav2Bag(), plain, options);
+  const std::string plain = convertedBag(dir, "plain", BagCompression::kNone);
   const std::string yaml = (fs::path(plain) / "metadata.yaml").string();
   std::string m = text(yaml);
   for (const auto& [from, to] : {std::pair<std::string, std::string>{"compression_format: \"\"", "compression_format: \"zstd\""},

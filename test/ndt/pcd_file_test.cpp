@@ -77,6 +77,15 @@ TEST(PcdFile, BadFilesGiveErrorsNamingTheFileAndTheReason) {
   expectLoadError(dir / "noxyz.pcd", "no x, y and z");
 }
 
+// Found by fuzzing (pcd_fuzzer): a file whose last line is "DATA ascii" with no newline after it put
+// the data one byte past the end, and reading it threw std::out_of_range past every caller.
+TEST(PcdFile, AFileEndingOnItsDataLineIsAnErrorNotACrash) {
+  testing::TempDir dir;
+  writeText(dir / "ends.pcd", "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii");
+  expectLoadError(dir / "ends.pcd", "ascii data ends after 0 of 1 points");
+  expectLoadError(COLOC_SOURCE_DIR "/test/support/fuzz_findings/pcd_data_line_ends_the_file.pcd", "not a readable PCD file");
+}
+
 TEST(PcdFile, TruncatedBinaryFileIsAnErrorNotACrash) {
   testing::TempDir dir;
   std::ifstream in(testing::realData("hdl32e_pair/target.pcd"), std::ios::binary);

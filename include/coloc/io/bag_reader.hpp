@@ -38,8 +38,11 @@ class BagReader {
   /// Reuses message.data's capacity. Throws coloc::Error on corrupt data.
   bool next(BagMessage& message);
 
+  /// Collect MCAP attachments and metadata records while reading (off by default: they are skipped
+  /// unread, as a replay has no use for them). Call before the first next().
+  void keepAttachments(bool keep);
   /// MCAP attachments and metadata records of the files next() has finished (all of them once it
-  /// returned false); rosbag2 sqlite3 storage has neither.
+  /// returned false), when kept; rosbag2 sqlite3 storage has neither.
   const std::vector<BagAttachment>& attachments() const;
   const std::vector<BagMetadataRecord>& metadataRecords() const;
 

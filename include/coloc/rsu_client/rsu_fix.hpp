@@ -32,9 +32,6 @@ struct RsuFix {
   std::optional<SentFields> sent;
 };
 
-/// The longest frame_id a fix may carry: ROS frame names are short; a longer one is malformed or hostile.
-inline constexpr std::size_t kMaxFrameIdBytes = 256;
-
 enum class FixRejection : std::uint8_t {
   kNone, kUnknownRsu, kNonFinite, kOutOfCoverage, kStale, kFromFuture, kDuplicate, kWrongFrame, kBadCovariance, kBadStamp
 };

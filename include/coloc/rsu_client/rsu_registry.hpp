@@ -2,11 +2,16 @@
 // The roadside units a vehicle trusts: where each stands in the map, which LiDAR it carries, how far
 // it sees, and the identity its DDS certificate carries. Loaded from config/rsu.yaml.
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace coloc::rsu_client {
+
+/// The longest frame name the registry and a fix may carry: ROS frame names are short; a longer one is
+/// malformed or hostile.
+inline constexpr std::size_t kMaxFrameIdBytes = 256;
 
 /// A roadside LiDAR model with the paper's figures.
 struct LidarModel {

@@ -1,0 +1,27 @@
+#include "odometry_integral.hpp"
+
+#include <cmath>
+
+namespace coloc::pipeline {
+
+void OdometryIntegral::add(Stamp stamp, double rate) {
+  if (!std::isfinite(rate)) return;
+  if (!marks_.empty() && stamp <= marks_.back().stamp) return;
+  const double integral =
+      marks_.empty() ? 0.0 : marks_.back().integral + 0.5 * (rate + marks_.back().rate) * toSeconds(stamp - marks_.back().stamp);
+  marks_.push_back({stamp, rate, integral});
+  // Enough to reach a pose stamped a sweep and a match ago.
+  while (marks_.size() > 2 && marks_.front().stamp < stamp - 2 * kNanosPerSecond) marks_.pop_front();
+}
+
+double OdometryIntegral::at(Stamp stamp) const {
+  auto after = marks_.begin();
+  while (after != marks_.end() && after->stamp < stamp) ++after;
+  if (after == marks_.begin()) return marks_.front().integral - marks_.front().rate * toSeconds(marks_.front().stamp - stamp);
+  if (after == marks_.end()) return marks_.back().integral + marks_.back().rate * toSeconds(stamp - marks_.back().stamp);
+  const auto before = after - 1;
+  const double w = static_cast<double>(stamp - before->stamp) / static_cast<double>(after->stamp - before->stamp);
+  return before->integral + w * (after->integral - before->integral);
+}
+
+}  // namespace coloc::pipeline
