@@ -15,8 +15,8 @@ Eigen::Matrix4d matrixOf(const Pose& pose) {
 
 }  // namespace
 
-NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config)
-    : config_((validate(config), config)), map_(std::move(map), config.ndt, config.map) {
+NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets)
+    : config_((validate(config), config)), map_(std::move(map), config.ndt, config.map, std::move(targets)) {
   const Vector6d& p = config.lidar_pose;
   Pose lidar;
   lidar.position = p.head<3>();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <sstream>
 
 #include "coloc/core/error.hpp"
 #include "coloc/ndt/pcd_file.hpp"
@@ -30,7 +31,14 @@ TileInfo boundsOf(const PointCloud& cloud, std::string path) {
 TileMap TileMap::open(const std::string& path, double tile_size) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (fs::is_regular_file(path, ec)) return fromCloud(loadPcd(path), tile_size);
+  if (fs::is_regular_file(path, ec)) {
+    TileMap map = fromCloud(loadPcd(path), tile_size);
+    std::ostringstream id;
+    id.precision(17);
+    id << fs::absolute(path, ec).string() << '@' << tile_size;
+    map.id_ = id.str();
+    return map;
+  }
   if (!fs::is_directory(path, ec)) throw Error(path + ": no such map file or folder");
   std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(path, ec))
@@ -38,6 +46,7 @@ TileMap TileMap::open(const std::string& path, double tile_size) {
   if (files.empty()) throw Error(path + ": the map folder holds no .pcd tile");
   std::sort(files.begin(), files.end());  // a stable order, whatever the file system lists
   TileMap map;
+  map.id_ = fs::absolute(path, ec).string();
   for (const std::string& file : files) map.tiles_.push_back(boundsOf(loadPcd(file), file));
   return map;
 }
@@ -49,10 +58,12 @@ TileMap TileMap::fromCloud(const PointCloud& cloud, double tile_size) {
   for (const auto& p : cloud.points)
     cells[{static_cast<long>(std::floor(p.x() / tile_size)), static_cast<long>(std::floor(p.y() / tile_size))}].points.push_back(p);
   TileMap map;
+  auto tiles = std::make_shared<std::vector<PointCloud>>();
   for (auto& [key, tile] : cells) {
     map.tiles_.push_back(boundsOf(tile, ""));
-    map.in_memory_.push_back(std::move(tile));
+    tiles->push_back(std::move(tile));
   }
+  map.in_memory_ = std::move(tiles);
   return map;
 }
 
@@ -67,12 +78,12 @@ std::vector<std::size_t> TileMap::tilesWithin(const Eigen::Vector2d& center, dou
 
 PointCloud TileMap::load(std::size_t tile) const {
   if (tile >= tiles_.size()) throw Error("map: no tile " + std::to_string(tile));
-  if (!in_memory_.empty()) return in_memory_[tile];
+  if (in_memory_) return (*in_memory_)[tile];
   return loadPcd(tiles_[tile].path);
 }
 
-DynamicMap::DynamicMap(TileMap map, const NdtConfig& ndt, const MapUpdateConfig& config)
-    : map_(std::move(map)), ndt_(ndt), config_(config) {
+DynamicMap::DynamicMap(TileMap map, const NdtConfig& ndt, const MapUpdateConfig& config, std::shared_ptr<TargetCache> targets)
+    : map_(std::move(map)), ndt_(ndt), config_(config), targets_(std::move(targets)) {
   if (config_.background) thread_ = std::thread([this] { worker(); });
 }
 
@@ -88,21 +99,32 @@ DynamicMap::~DynamicMap() {
 void DynamicMap::build(const Eigen::Vector2d& center) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<std::size_t> tiles = map_.tilesWithin(center, config_.radius);
-  std::map<std::size_t, PointCloud> loaded;
-  PointCloud cloud;
-  for (std::size_t t : tiles) {
-    auto kept = loaded_.find(t);
-    PointCloud& tile = loaded[t] = kept != loaded_.end() ? std::move(kept->second) : map_.load(t);
-    cloud.points.insert(cloud.points.end(), tile.points.begin(), tile.points.end());
+  auto make = [&]() -> std::shared_ptr<const NdtTarget> {
+    std::map<std::size_t, PointCloud> loaded;
+    PointCloud cloud;
+    for (std::size_t t : tiles) {
+      auto kept = loaded_.find(t);
+      PointCloud& tile = loaded[t] = kept != loaded_.end() ? std::move(kept->second) : map_.load(t);
+      cloud.points.insert(cloud.points.end(), tile.points.begin(), tile.points.end());
+    }
+    loaded_ = std::move(loaded);  // tiles out of range are released here
+    return cloud.empty() ? nullptr : std::make_shared<const NdtTarget>(cloud, ndt_);
+  };
+  std::shared_ptr<const NdtTarget> next;
+  if (targets_ && !map_.id().empty() && !tiles.empty()) {
+    next = targets_->get(map_.id(), tiles, ndt_, make);
+    // While the cache serves, tiles read for earlier builds are released once out of range, as above.
+    for (auto it = loaded_.begin(); it != loaded_.end();)
+      it = std::binary_search(tiles.begin(), tiles.end(), it->first) ? std::next(it) : loaded_.erase(it);
+  } else {
+    next = make();
   }
-  loaded_ = std::move(loaded);  // tiles out of range are released here
-  std::shared_ptr<const NdtTarget> next = cloud.empty() ? nullptr : std::make_shared<const NdtTarget>(cloud, ndt_);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   target_ = std::move(next);  // alignments holding the old target keep it alive until they finish
   ++stats_.builds;
   stats_.tiles_in_target = tiles.size();
-  stats_.points_in_target = cloud.size();
+  stats_.points_in_target = target_ ? target_->pointCount() : 0;
   stats_.voxels_in_target = target_ ? target_->voxelCount() : 0;
   stats_.last_build_ms = ms;
 }

@@ -24,12 +24,16 @@ class VoxelLookup {
   void finish();
 
   const Voxel* find(const Eigen::Vector3i& coordinates) const {
-    if (slots_.empty()) return nullptr;
+    const std::int64_t i = indexOf(coordinates);
+    return i < 0 ? nullptr : &voxels_[static_cast<std::size_t>(i)];
+  }
+  /// The voxel's position in voxels(), -1 if there is none at these coordinates.
+  std::int64_t indexOf(const Eigen::Vector3i& coordinates) const {
+    if (slots_.empty()) return -1;
     const std::uint64_t key = pack(coordinates);
     for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
       const Slot& s = slots_[i];
-      if (s.voxel < 0) return nullptr;
-      if (s.key == key) return &voxels_[static_cast<std::size_t>(s.voxel)];
+      if (s.voxel < 0 || s.key == key) return s.voxel;
     }
   }
 

@@ -195,7 +195,7 @@ struct Pipeline::Impl {
       ndt::NdtPoseSourceConfig ndt_config = config.ndt.source;
       // Offline the target is built inline: the same log then gives the same bytes, whatever the machine's speed.
       if (!options.ndt_thread) ndt_config.map.background = false;
-      ndt = std::make_unique<ndt::NdtPoseSource>(std::move(*options.map), ndt_config);
+      ndt = std::make_unique<ndt::NdtPoseSource>(std::move(*options.map), ndt_config, options.targets);
       ndt_id = addSource(kNdtSource, fusion::SourceKind::kPose);
       report.ndt_used = true;
       if (options.ndt_thread)

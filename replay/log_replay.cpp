@@ -27,7 +27,33 @@ struct Event {
   Stamp arrival;  ///< log_time on the stamp clock
   std::uint64_t order;
   std::size_t topic;
-  std::variant<PoseMeasurement, TwistMeasurement, ndt::PointCloud, rsu_client::RsuFix> input;
+  std::variant<PoseMeasurement, TwistMeasurement, std::shared_ptr<const ndt::PointCloud>, rsu_client::RsuFix> input;
+};
+
+using ScanPtr = std::shared_ptr<const ndt::PointCloud>;
+
+// The log's messages in order, from the file or from a log held in memory (ReplayCache).
+class MessageSource {
+ public:
+  explicit MessageSource(io::BagReader& bag) : bag_(&bag) {}
+  explicit MessageSource(const RecordedLog& log) : log_(&log) {}
+  std::uint64_t count() const { return bag_ ? bag_->messageCount() : log_->messages().size(); }
+  const io::BagMessage* next() {
+    if (bag_) return bag_->next(message_) ? &message_ : nullptr;
+    return next_ < log_->messages().size() ? &log_->messages()[next_++] : nullptr;
+  }
+  RecordedLog::Scan scan(const io::BagMessage& m, io::MessageKind kind) const {
+    if (log_) return log_->scan(m.index, kind);
+    const io::RosMessage decoded = io::decodeMessage(kind, m.data);
+    const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
+    return {cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud))};
+  }
+
+ private:
+  io::BagReader* bag_ = nullptr;
+  io::BagMessage message_;
+  const RecordedLog* log_ = nullptr;
+  std::size_t next_ = 0;
 };
 
 double median(std::vector<double> v) {
@@ -37,16 +63,16 @@ double median(std::vector<double> v) {
 }
 
 // Stage 2: every message of a used topic, decoded; ground truth goes straight into the result.
-std::vector<Event> decodeAll(io::BagReader& bag, const pipeline::Config& config, ReplayResult& result,
+std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& config, ReplayResult& result,
                              const std::function<void(double)>& progress) {
   std::map<std::string, std::size_t> topic_index;
   for (std::size_t i = 0; i < result.topics.size(); ++i) topic_index[result.topics[i].topic] = i;
   std::vector<Event> events;
-  const std::uint64_t total = std::max<std::uint64_t>(bag.messageCount(), 1);
-  io::BagMessage message;
+  const std::uint64_t total = std::max<std::uint64_t>(source.count(), 1);
   // Earliest and latest, not first and last: files need not be in time order.
   Stamp first_log = 0, last_log = 0;
-  while (bag.next(message)) {
+  while (const io::BagMessage* next = source.next()) {
+    const io::BagMessage& message = *next;
     first_log = result.messages_read == 0 ? message.log_time : std::min(first_log, message.log_time);
     last_log = result.messages_read == 0 ? message.log_time : std::max(last_log, message.log_time);
     if (progress && result.messages_read % 256 == 0) progress(0.5 * result.messages_read / total);
@@ -59,17 +85,17 @@ std::vector<Event> decodeAll(io::BagReader& bag, const pipeline::Config& config,
     if (use.role == InputRole::kIgnore) continue;
     const InputConfig* input = use.from_config ? &config.inputs.at(use.topic) : nullptr;
     try {
+      Event e{message.log_time, 0, 0, message.index, ti, PoseMeasurement{}};
+      if (use.role == InputRole::kScan) {
+        RecordedLog::Scan scan = source.scan(message, *use.kind);
+        e.stamp = scan.stamp;
+        e.input = std::move(scan.cloud);
+        events.push_back(std::move(e));
+        continue;
+      }
       const io::RosMessage decoded = io::decodeMessage(*use.kind, message.data);
       bool fallback = false;
-      Event e{message.log_time, 0, 0, message.index, ti, PoseMeasurement{}};
       switch (use.role) {
-        case InputRole::kScan: {
-          const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
-          e.stamp = cloud.header.stamp;
-          e.input = pipeline::toPointCloud(cloud);
-          events.push_back(std::move(e));
-          continue;
-        }
         case InputRole::kGroundTruth: {
           const PoseMeasurement p = pipeline::poseFromMessage(decoded, input, config.messages, fallback);
           result.ground_truth.push_back({p.stamp, p.pose});
@@ -89,7 +115,7 @@ std::vector<Event> decodeAll(io::BagReader& bag, const pipeline::Config& config,
       // The measurement's own stamp, moved back by the configured sensing delay.
       std::visit(
           [&](auto& m) {
-            if constexpr (!std::is_same_v<std::decay_t<decltype(m)>, ndt::PointCloud>) {
+            if constexpr (!std::is_same_v<std::decay_t<decltype(m)>, ScanPtr>) {
               if (input && input->additional_delay > 0.0) m.stamp -= fromSeconds(input->additional_delay);
               e.stamp = m.stamp;
             }
@@ -165,7 +191,11 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   po.registry = std::move(registry);
   bool scans = false;
   for (const TopicUse& t : result.topics) scans = scans || t.role == InputRole::kScan;
-  if (scans && !options.map.empty()) po.map = ndt::TileMap::open(options.map, options.config.ndt.map_tile_size);
+  if (scans && !options.map.empty()) {
+    po.map = options.cache ? options.cache->map(options.map, options.config.ndt.map_tile_size)
+                           : ndt::TileMap::open(options.map, options.config.ndt.map_tile_size);
+    if (options.cache) po.targets = options.cache->targets();
+  }
   pipeline::Pipeline pipe(options.config, std::move(po));
   std::vector<fusion::SourceId> source_of(result.topics.size(), -1);
   for (std::size_t i = 0; i < result.topics.size(); ++i) {
@@ -196,9 +226,12 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   });
   for (std::size_t i = 0; i < events.size(); ++i) {
     Event& e = events[i];
-    if (options.progress && (i % 256 == 0 || std::holds_alternative<ndt::PointCloud>(e.input)))
+    if (options.progress && (i % 256 == 0 || std::holds_alternative<ScanPtr>(e.input)))
       options.progress(0.5 + 0.5 * i / events.size());
-    if (auto* scan = std::get_if<ndt::PointCloud>(&e.input)) pipe.pushScan(std::move(*scan), e.stamp, e.arrival);
+    if (auto* scan = std::get_if<ScanPtr>(&e.input)) {
+      pipe.pushScan(ndt::PointCloud(**scan), e.stamp, e.arrival);
+      scan->reset();  // a scan not shared with other replays is released once matched
+    }
     else if (auto* fix = std::get_if<rsu_client::RsuFix>(&e.input)) pipe.pushFix(*fix, e.arrival);
     else if (auto* twist = std::get_if<TwistMeasurement>(&e.input)) pipe.pushTwist(source_of[e.topic], *twist, e.arrival);
     else pipe.pushPose(source_of[e.topic], std::get<PoseMeasurement>(e.input), e.arrival);
@@ -228,21 +261,26 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   const pipeline::Config& config = options.config;
   std::optional<rsu_client::RsuRegistry> registry = options.registry;
   if (!registry && !config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(config.rsu.registry);
-  io::BagReader bag = io::BagReader::open(log_path);
+  std::optional<io::BagReader> bag;
+  std::shared_ptr<const RecordedLog> recorded;
+  if (options.cache) recorded = options.cache->log(log_path);
+  else bag.emplace(io::BagReader::open(log_path));
+  const std::vector<io::TopicInfo>& log_topics = recorded ? recorded->topics() : bag->topics();
   ReplayResult result;
-  result.topics = planTopics(bag.topics(), config, !options.map.empty(), registry ? &*registry : nullptr, result.rejections);
+  result.topics = planTopics(log_topics, config, !options.map.empty(), registry ? &*registry : nullptr, result.rejections);
   const bool has_input = std::any_of(result.topics.begin(), result.topics.end(), [](const TopicUse& t) {
     return t.role == InputRole::kPose || t.role == InputRole::kTwist || t.role == InputRole::kScan || t.role == InputRole::kRsuFix;
   });
   if (!has_input) {
     std::vector<TopicUse> listed = result.topics;
     for (TopicUse& t : listed)
-      for (const io::TopicInfo& info : bag.topics())
+      for (const io::TopicInfo& info : log_topics)
         if (info.name == t.topic) t.messages = info.message_count;
     throw Error(log_path + ": nothing to fuse: no topic is a pose, twist, scan (with a map) or RSU fix input. The log holds:\n" +
                 describeTopics(listed));
   }
-  std::vector<Event> events = decodeAll(bag, config, result, options.progress);
+  MessageSource source = recorded ? MessageSource(*recorded) : MessageSource(*bag);
+  std::vector<Event> events = decodeAll(source, config, result, options.progress);
   placeOnStampClock(events, config, result);
   emulateLinks(events, config, result);
   measureDelays(events, result);

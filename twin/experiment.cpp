@@ -95,6 +95,7 @@ SiteInfo siteInfo(const sim::Scenario& s) {
 struct Job {
   ExperimentRun run;
   std::string log, map;
+  std::shared_ptr<replay::ReplayCache> cache;  ///< shared by the drive's replays
   pipeline::Config config;
   std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSU, its fixes through the registry's checks
   std::string fix_topic;  ///< the fused RSU topic, empty for NDT only
@@ -131,6 +132,7 @@ void runJob(Job& job) {
   options.config = job.config;
   options.registry = job.registry;
   options.map = job.map;
+  options.cache = job.cache;
   replay::ReplayResult r;
   if (job.smooth || job.calibrate) {
     replay::SmoothOptions so;
@@ -301,6 +303,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
 
   std::vector<sim::Scenario> scenarios;
   std::vector<std::string> maps(config.sites.size());
+  // A site's drives follow one route on one map: they share its NDT targets (about 15 along a drive).
+  std::vector<std::shared_ptr<ndt::TargetCache>> site_targets;
+  for (std::size_t s = 0; s < config.sites.size(); ++s) site_targets.push_back(std::make_shared<ndt::TargetCache>(32));
   for (const std::string& site : config.sites) {
     scenarios.push_back(siteScenario(site, config));
     results.sites.push_back(siteInfo(scenarios.back()));
@@ -393,6 +398,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     fuse.ndt.source.lidar_pose[2] = scenario.vehicle_lidar_height;
     std::vector<Eigen::Vector2d> rsu_positions;
     for (const sim::ScenarioRsu& r : scenario.rsus) rsu_positions.push_back(r.position);
+    // The drive's replays read its log once, and each NDT target of the site is built once (the same
+    // results as apart).
+    auto cache = std::make_shared<replay::ReplayCache>(site_targets[drive.site]);
     auto makeJob = [&](const std::string& lidar, double delay, double loss, const std::string& job_variant,
                        std::optional<double> variance) {
       Job job;
@@ -404,6 +412,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.run.variant = job_variant;
       job.log = rec.out_dir + "/log";
       job.map = maps[drive.site];
+      job.cache = cache;
       job.config = fuse;
       job.rsu_positions = rsu_positions;
       if (const auto& v = ndt_variance[drive.site]) {

@@ -49,6 +49,43 @@ TEST(NdtScore, GradientAndHessianMatchNumericDerivatives) {
   }
 }
 
+TEST(NdtScore, TheNeighbourCacheGivesTheSameBitsAsTheFullSearchWhereverThePointsMove) {
+  // A dense random field of voxels (every cell, means anywhere in their cells) and points spread over
+  // it; the pose then walks away step by step, so that points regather after a quarter voxel and cross
+  // cells. Every evaluation must equal the uncached one exactly, NVTL included.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  VoxelLookup voxels;
+  for (int i = -4; i < 8; ++i)
+    for (int j = -4; j < 8; ++j)
+      for (int l = -2; l < 3; ++l) {
+        if (u(rng) < 0.3) continue;
+        Eigen::Matrix3d A = Eigen::Matrix3d::Random();
+        const Eigen::Matrix3d cov = 0.1 * A * A.transpose() + 0.05 * Eigen::Matrix3d::Identity();
+        voxels.insert(Eigen::Vector3i(i, j, l), {2.0 * Eigen::Vector3d(i + u(rng), j + u(rng), l + u(rng)), cov.inverse()});
+      }
+  voxels.finish();
+  std::vector<Eigen::Vector3f> source;
+  for (int k = 0; k < 2000; ++k)
+    source.emplace_back(static_cast<float>(-4.0 + 16.0 * u(rng)), static_cast<float>(-4.0 + 16.0 * u(rng)), static_cast<float>(-2.0 + 4.0 * u(rng)));
+  const ScoreConstants k = scoreConstants(2.0, 0.55);
+  ScoreOptions options;
+  options.nvtl = true;
+  NeighbourCache cache(source.size(), 2.0, 0.5);
+  Vector6d pose = Vector6d::Zero();
+  for (int step = 0; step < 40; ++step) {
+    pose += (Vector6d() << 0.07, -0.05, 0.03, 0.004, -0.003, 0.01).finished();
+    const ScoreEvaluation plain = evaluateScore(voxels, 2.0, k, source, pose, options);
+    const ScoreEvaluation cached = evaluateScore(voxels, 2.0, k, source, pose, options, &cache);
+    ASSERT_GT(plain.nvtl_points, 500u);
+    EXPECT_EQ(plain.score, cached.score) << "step " << step;
+    EXPECT_EQ(plain.gradient, cached.gradient) << "step " << step;
+    EXPECT_EQ(plain.hessian, cached.hessian) << "step " << step;
+    EXPECT_EQ(plain.nvtl_sum, cached.nvtl_sum) << "step " << step;
+    EXPECT_EQ(plain.nvtl_points, cached.nvtl_points) << "step " << step;
+  }
+}
+
 TEST(NdtScore, PoseVectorAndMatrixRoundTrip) {
   Vector6d pose;
   pose << 1.0, -2.0, 0.5, 0.1, -0.2, 2.5;

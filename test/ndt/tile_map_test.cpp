@@ -82,6 +82,55 @@ TEST(DynamicMap, TargetFollowsTheVehicleAndHoldsOnlyTheTilesInRange) {
   EXPECT_GT(old_target->voxelCount(), 0u);
 }
 
+TEST(DynamicMap, MapsSharingATargetCacheBuildEachSetOfTilesOnceAndGetTheSameTarget) {
+  testing::TempDir dir;
+  const std::string folder = writeTiles(dir, 6);
+  NdtConfig ndt;
+  MapUpdateConfig config;
+  config.radius = 25.0;
+  config.background = false;
+  auto cache = std::make_shared<TargetCache>(4);
+  DynamicMap a(TileMap::open(folder), ndt, config, cache), b(TileMap::open(folder), ndt, config, cache);
+  a.update({10.0, 10.0});
+  b.update({11.0, 9.0});  // another centre, the same tiles
+  EXPECT_EQ(a.target(), b.target());
+  EXPECT_EQ(cache->stats().builds, 1u);
+  EXPECT_EQ(cache->stats().requests, 2u);
+  // Another resolution is another target, even on the same tiles.
+  NdtConfig coarse = ndt;
+  coarse.resolution = 4.0;
+  DynamicMap c(TileMap::open(folder), coarse, config, cache);
+  c.update({10.0, 10.0});
+  EXPECT_NE(c.target(), a.target());
+  EXPECT_EQ(cache->stats().builds, 2u);
+  // The cached target holds what an uncached build of the same tiles holds.
+  DynamicMap alone(TileMap::open(folder), ndt, config);
+  alone.update({10.0, 10.0});
+  EXPECT_EQ(alone.target()->voxelCount(), a.target()->voxelCount());
+  EXPECT_EQ(alone.target()->pointCount(), a.target()->pointCount());
+  EXPECT_EQ(alone.stats().points_in_target, a.stats().points_in_target);
+  // Past its capacity the cache forgets the least recently used set of tiles; maps keep theirs.
+  const auto kept = a.target();
+  for (double x : {50.0, 90.0, 110.0, 30.0}) b.update({x, x});
+  EXPECT_EQ(cache->stats().builds, 6u);
+  a.update({80.0, 10.0});
+  b.update({80.0, 10.0});
+  EXPECT_EQ(a.target(), b.target());
+  EXPECT_GT(kept->voxelCount(), 0u);
+}
+
+TEST(TargetCache, AFailedBuildReachesItsCallerAndIsNotKept) {
+  TargetCache cache(2);
+  NdtConfig ndt;
+  EXPECT_THROW(cache.get("m", {1, 2}, ndt, []() -> std::shared_ptr<const NdtTarget> { throw Error("tile unreadable"); }), Error);
+  PointCloud cloud;
+  for (int i = 0; i < 200; ++i) cloud.points.emplace_back(0.01f * i, 0.013f * (i % 17), 0.007f * (i % 5));
+  const auto built = cache.get("m", {1, 2}, ndt, [&] { return std::make_shared<const NdtTarget>(cloud, ndt); });
+  ASSERT_NE(built, nullptr);
+  EXPECT_EQ(cache.stats().builds, 2u);
+  EXPECT_EQ(cache.get("m", {1, 2}, ndt, []() -> std::shared_ptr<const NdtTarget> { throw Error("not called"); }), built);
+}
+
 TEST(DynamicMap, ScanAlignsAgainstTheTilesAroundIt) {
   testing::TempDir dir;
   NdtConfig ndt;

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -207,21 +209,26 @@ io::PointCloud2 toMessage(const ndt::PointCloud& cloud, Stamp stamp) {
   return m;
 }
 
+// The real HDL-32E pair's source scan `count` times, 0.1 s apart, as a standing vehicle would see it;
+// the message at `truncated` (if any) cut to a third.
+void writeScanLog(const std::string& path, int count, int truncated = -1) {
+  const ndt::PointCloud scan = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
+  const Stamp t0 = 1'700'000'000'000'000'000LL;
+  io::BagWriter bag = io::BagWriter::create(path);
+  bag.addTopic(topicOf("/points", "sensor_msgs/msg/PointCloud2"));
+  for (int i = 0; i < count; ++i) {
+    io::Bytes b = io::encodePointCloud2(toMessage(scan, t0 + i * 100'000'000LL));
+    if (i == truncated) b.resize(b.size() / 3);
+    bag.write("/points", t0 + i * 100'000'000LL + 30'000'000LL, b.data(), b.size());
+  }
+  bag.close();
+}
+
 TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   // The real HDL-32E pair: the target scan is the map, the source scan is in the log.
   testing::TempDir dir;
   const std::string map = testing::realData("hdl32e_pair/target.pcd");
-  const ndt::PointCloud scan = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
-  const Stamp t0 = 1'700'000'000'000'000'000LL;
-  {
-    io::BagWriter bag = io::BagWriter::create(dir / "scans");
-    bag.addTopic(topicOf("/points", "sensor_msgs/msg/PointCloud2"));
-    for (int i = 0; i < 3; ++i) {  // the same scan three times, 0.1 s apart, as a standing vehicle would see it
-      const io::Bytes b = io::encodePointCloud2(toMessage(scan, t0 + i * 100'000'000LL));
-      bag.write("/points", t0 + i * 100'000'000LL + 30'000'000LL, b.data(), b.size());
-    }
-    bag.close();
-  }
+  writeScanLog(dir / "scans", 3);
   ReplayOptions options;
   options.map = map;
   options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
@@ -235,6 +242,46 @@ TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   EXPECT_NEAR(r.pose_inputs.back().pose.position.x(), gt1(0, 3), 0.03);
   EXPECT_NEAR(r.pose_inputs.back().pose.position.y(), gt1(1, 3), 0.03);
   EXPECT_GE(counters(r, "ndt").applied, 3u);
+}
+
+TEST(LogReplay, ReplaysSharingACacheGiveTheSameResultsAsReplaysApart) {
+  // Scans (one of them truncated), replayed from two starting poses side by side through one cache and
+  // each alone: the same fused output, NDT counters and decode errors; the log is read once.
+  testing::TempDir dir;
+  const std::string map = testing::realData("hdl32e_pair/target.pcd");
+  writeScanLog(dir / "scans", 4, 2);
+  auto optionsFrom = [&](const std::string& start) {
+    ReplayOptions options;
+    options.map = map;
+    options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [" + start + ", 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
+    return options;
+  };
+  const std::vector<std::string> starts = {"0.3, 0.3", "-0.2, 0.4"};
+  auto cache = std::make_shared<ReplayCache>();
+  std::vector<ReplayResult> shared(starts.size()), apart(starts.size());
+  std::vector<std::thread> threads;
+  for (std::size_t i = 0; i < starts.size(); ++i)
+    threads.emplace_back([&, i] {
+      ReplayOptions options = optionsFrom(starts[i]);
+      options.cache = cache;
+      shared[i] = replayLog(dir / "scans", options);
+    });
+  for (std::thread& t : threads) t.join();
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    apart[i] = replayLog(dir / "scans", optionsFrom(starts[i]));
+    ASSERT_EQ(shared[i].fused.size(), apart[i].fused.size());
+    for (std::size_t k = 0; k < apart[i].fused.size(); ++k) {
+      EXPECT_EQ(shared[i].fused[k].stamp, apart[i].fused[k].stamp);
+      EXPECT_EQ(shared[i].fused[k].pose.position, apart[i].fused[k].pose.position) << "start " << starts[i] << ", tick " << k;
+    }
+    EXPECT_EQ(shared[i].ndt.poses, apart[i].ndt.poses);
+    EXPECT_EQ(topic(shared[i], "/points").decode_errors, 1u);
+    EXPECT_EQ(topic(shared[i], "/points").first_error, topic(apart[i], "/points").first_error);
+    EXPECT_EQ(shared[i].summaryJson("log"), apart[i].summaryJson("log"));
+  }
+  EXPECT_EQ(apart[0].ndt.scans, 3u);
+  EXPECT_EQ(cache->log(dir / "scans").use_count(), 2);  // the cache's copy and this one: read once
+  EXPECT_EQ(cache->targets()->stats().builds, 1u);
 }
 
 TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {

@@ -44,7 +44,8 @@ struct ScanOutcome {
 
 class NdtPoseSource {
  public:
-  NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config);
+  /// `targets`: a cache of NDT targets shared with other sources on the same map (see target_cache.hpp).
+  NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets = nullptr);
 
   /// `scan` in the LiDAR frame, `predicted` the vehicle pose the filter predicts for `stamp`, `vx` and
   /// `wz` its twist (for deskewing). Never throws for bad scans: the outcome says what happened.

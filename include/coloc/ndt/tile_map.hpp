@@ -17,6 +17,7 @@
 #include "coloc/ndt/ndt_config.hpp"
 #include "coloc/ndt/ndt_target.hpp"
 #include "coloc/ndt/point_cloud.hpp"
+#include "coloc/ndt/target_cache.hpp"
 
 namespace coloc::ndt {
 
@@ -38,10 +39,15 @@ class TileMap {
   /// Tiles whose bounds come within `radius` of `center` (x-y).
   std::vector<std::size_t> tilesWithin(const Eigen::Vector2d& center, double radius) const;
   PointCloud load(std::size_t tile) const;
+  /// Names the map for a TargetCache: its path and tile size; empty for a map made from a cloud in
+  /// memory, whose targets are not shared.
+  const std::string& id() const { return id_; }
 
  private:
+  std::string id_;
   std::vector<TileInfo> tiles_;
-  std::vector<PointCloud> in_memory_;  ///< for sliced single-file maps
+  /// For sliced single-file maps; shared, so that copies of a map cost no copy of its points.
+  std::shared_ptr<const std::vector<PointCloud>> in_memory_;
 };
 
 struct MapUpdateConfig {
@@ -60,7 +66,8 @@ struct DynamicMapStats {
 
 class DynamicMap {
  public:
-  DynamicMap(TileMap map, const NdtConfig& ndt, const MapUpdateConfig& config);
+  /// With `targets`, a target is taken from (or put into) the cache instead of always being built.
+  DynamicMap(TileMap map, const NdtConfig& ndt, const MapUpdateConfig& config, std::shared_ptr<TargetCache> targets = nullptr);
   ~DynamicMap();
   DynamicMap(const DynamicMap&) = delete;
   DynamicMap& operator=(const DynamicMap&) = delete;
@@ -82,6 +89,7 @@ class DynamicMap {
   TileMap map_;
   NdtConfig ndt_;
   MapUpdateConfig config_;
+  std::shared_ptr<TargetCache> targets_;
   mutable std::mutex mutex_;
   std::condition_variable wake_, idle_;
   std::shared_ptr<const NdtTarget> target_;

@@ -37,6 +37,8 @@ struct PipelineOptions {
   /// Live: the clock the pipeline's thread runs on and NDT's results arrive by; unset: the system
   /// clock. A node on a recorded log's time (ROS 2's use_sim_time) gives the /clock it receives.
   std::function<Stamp()> clock;
+  /// NDT targets shared with other pipelines on the same map (replays of one drive side by side).
+  std::shared_ptr<ndt::TargetCache> targets;
 };
 
 /// What the pipeline has done so far: per-source filter counters, NDT, fixes, rejections.

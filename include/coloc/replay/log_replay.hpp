@@ -19,6 +19,7 @@
 #include "coloc/pipeline/pipeline.hpp"
 #include "coloc/replay/clock_fit.hpp"
 #include "coloc/replay/evaluation.hpp"
+#include "coloc/replay/replay_cache.hpp"
 #include "coloc/replay/topic_plan.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 
@@ -87,6 +88,8 @@ struct ReplayOptions {
   std::optional<rsu_client::RsuRegistry> registry;
   std::function<void(double fraction)> progress;  ///< called now and then with 0..1
   bool keep_filter_inputs = false;  ///< fill filter_poses, filter_twists and fused_states
+  /// Shared with other replays of the same log or map: read, decode and build once (same results).
+  std::shared_ptr<ReplayCache> cache;
 };
 
 /// Throws coloc::Error if the log cannot be read at all; bad messages inside it are counted, not fatal.

@@ -1,0 +1,65 @@
+#pragma once
+// What replays of one log share when they run side by side with different configurations (the
+// experiment replays each simulated drive about twenty times): the log read once, its scans decoded
+// once, the map's tile index read once, and NDT targets built once per set of tiles. Everything shared
+// is immutable once made, so a replay with the cache gives the same bytes as one without.
+//
+// Thread-safe. Memory: a log is held whole (its messages and decoded scans) while the cache lives.
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "coloc/core/time.hpp"
+#include "coloc/io/bag_message.hpp"
+#include "coloc/io/ros_messages.hpp"
+#include "coloc/ndt/point_cloud.hpp"
+#include "coloc/ndt/target_cache.hpp"
+#include "coloc/ndt/tile_map.hpp"
+
+namespace coloc::replay {
+
+/// A log read whole into memory.
+class RecordedLog {
+ public:
+  /// Throws coloc::Error as io::BagReader does for a log it cannot read.
+  explicit RecordedLog(const std::string& path);
+  ~RecordedLog();
+
+  const std::vector<io::TopicInfo>& topics() const { return topics_; }
+  const std::vector<io::BagMessage>& messages() const { return messages_; }
+
+  struct Scan {
+    Stamp stamp = 0;
+    std::shared_ptr<const ndt::PointCloud> cloud;
+  };
+  /// Message i decoded as a point cloud (PointCloud2 as `kind`), on its first request only. Throws
+  /// coloc::Error, every time it is asked, for a message that does not decode.
+  Scan scan(std::size_t i, io::MessageKind kind) const;
+
+ private:
+  struct Slot;
+  std::vector<io::TopicInfo> topics_;
+  std::vector<io::BagMessage> messages_;
+  std::unique_ptr<Slot[]> slots_;
+};
+
+class ReplayCache {
+ public:
+  /// `targets`: NDT targets shared beyond this cache (drives on one site); none: a cache of its own.
+  explicit ReplayCache(std::shared_ptr<ndt::TargetCache> targets = nullptr);
+
+  /// The log at `path`, read on its first request (a concurrent request waits for that read).
+  std::shared_ptr<const RecordedLog> log(const std::string& path);
+  /// The map at `path` (ndt::TileMap::open), indexed on its first request.
+  ndt::TileMap map(const std::string& path, double tile_size);
+  const std::shared_ptr<ndt::TargetCache>& targets() const { return targets_; }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::pair<std::string, std::shared_ptr<const RecordedLog>>> logs_;
+  std::vector<std::pair<std::string, std::shared_ptr<const ndt::TileMap>>> maps_;
+  std::shared_ptr<ndt::TargetCache> targets_;
+};
+
+}  // namespace coloc::replay

@@ -1,0 +1,73 @@
+#include "coloc/replay/replay_cache.hpp"
+
+#include <mutex>
+#include <sstream>
+
+#include "coloc/core/error.hpp"
+#include "coloc/io/bag_reader.hpp"
+#include "coloc/pipeline/message_inputs.hpp"
+
+namespace coloc::replay {
+
+struct RecordedLog::Slot {
+  std::once_flag once;
+  Scan scan;
+  std::string error;
+};
+
+RecordedLog::RecordedLog(const std::string& path) {
+  io::BagReader bag = io::BagReader::open(path);
+  topics_ = bag.topics();
+  messages_.reserve(bag.messageCount());
+  io::BagMessage message;
+  while (bag.next(message)) messages_.push_back(std::move(message));
+  slots_ = std::make_unique<Slot[]>(messages_.size());
+}
+
+RecordedLog::~RecordedLog() = default;
+
+RecordedLog::Scan RecordedLog::scan(std::size_t i, io::MessageKind kind) const {
+  if (i >= messages_.size()) throw Error("recorded log: no message " + std::to_string(i));
+  Slot& slot = slots_[i];
+  std::call_once(slot.once, [&] {
+    try {
+      const io::RosMessage decoded = io::decodeMessage(kind, messages_[i].data);
+      const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
+      slot.scan.stamp = cloud.header.stamp;
+      slot.scan.cloud = std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud));
+    } catch (const Error& e) {
+      slot.error = e.what();
+    } catch (const std::bad_variant_access&) {
+      slot.error = "not a point cloud";
+    }
+  });
+  if (!slot.error.empty()) throw Error(slot.error);
+  return slot.scan;
+}
+
+ReplayCache::ReplayCache(std::shared_ptr<ndt::TargetCache> targets)
+    : targets_(targets ? std::move(targets) : std::make_shared<ndt::TargetCache>()) {}
+
+std::shared_ptr<const RecordedLog> ReplayCache::log(const std::string& path) {
+  // Held while reading: replays of one drive start together and all want the same log.
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [p, log] : logs_)
+    if (p == path) return log;
+  auto log = std::make_shared<const RecordedLog>(path);
+  logs_.emplace_back(path, log);
+  return log;
+}
+
+ndt::TileMap ReplayCache::map(const std::string& path, double tile_size) {
+  std::ostringstream key;
+  key.precision(17);
+  key << path << '@' << tile_size;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [k, map] : maps_)
+    if (k == key.str()) return *map;
+  auto map = std::make_shared<const ndt::TileMap>(ndt::TileMap::open(path, tile_size));
+  maps_.emplace_back(key.str(), map);
+  return *map;
+}
+
+}  // namespace coloc::replay
