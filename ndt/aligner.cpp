@@ -1,6 +1,6 @@
 #include "coloc/ndt/aligner.hpp"
 
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <mutex>
@@ -34,13 +34,68 @@ struct Optimisation {
   bool converged = false;
 };
 
-// Newton's method on the NDT score with each step clamped to step_size, as Autoware's ndt_scan_matcher
-// does, plus what its line search provides: a step is taken only if the score rises. Far from the
-// optimum the Hessian can be indefinite, and plain clamped Newton then zig-zags (seen on 1,000-point
-// scans started 0.5 m off); there the Hessian is shifted until it is negative definite
-// (Levenberg-style), and a step that lowers the score is halved. The evaluation at an accepted pose is
-// reused for the next iteration, so the safeguard costs nothing while steps succeed. Stops as PCL does,
-// on the squared translation of a step.
+// Newton's method on the NDT score inside a trust region (More & Sorensen 1983; Nocedal & Wright ch. 4).
+// Autoware's ndt_scan_matcher clamps every step to step_size, so a start 2 m off needs 20 of its 30
+// iterations, and where the Hessian is indefinite (far from the optimum; on 1,000-point scans often)
+// the clamped Newton step aims at a saddle and the line search stalls. Here each step maximises the
+// score's quadratic model within a radius: the Newton step when the Hessian is negative definite and
+// the step fits, else the model's maximum on the radius, found exactly from the Hessian's eigenvectors
+// (a Levenberg shift -H + lambda I, lambda solving |s| = radius). The radius starts at step_size,
+// doubles while the model predicts the score's rise well, shrinks when it does not, and a step that
+// lowers the score is refused. Rotations count in the radius at kLeverArm metres per radian, so that
+// a radius bounds how far any point within that range moves. Converged when a full Newton step moves
+// the pose less than transformation_epsilon (squared translation, PCL's test) and turns it less than
+// kRotationEpsilon, or when no step as long as kSmallestRadius raises the score.
+constexpr double kLeverArm = 10.0;         // m
+constexpr double kRotationEpsilon = 2e-4;  // rad: 1 cm at 50 m, the translation test's 1 cm
+constexpr double kSmallestRadius = 1e-3;   // m (scaled 6-D step norm)
+
+struct TrustStep {
+  Vector6d step;        ///< in the pose's own units
+  bool newton = false;  ///< the unconstrained Newton step (the Hessian negative definite, the step inside)
+};
+
+// Maximises g's + s'Hs/2 subject to |D s| <= radius, D = diag(1, 1, 1, L, L, L).
+TrustStep trustRegionStep(const Vector6d& gradient, const Matrix6d& hessian, double radius) {
+  Vector6d d;
+  d << 1.0, 1.0, 1.0, kLeverArm, kLeverArm, kLeverArm;
+  const Vector6d gu = gradient.cwiseQuotient(d);
+  const Matrix6d M = -(d.asDiagonal().inverse() * hessian * d.asDiagonal().inverse());
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(M);
+  const Vector6d mu = eigen.eigenvalues();  // ascending
+  const Matrix6d& V = eigen.eigenvectors();
+  const Vector6d a = V.transpose() * gu;
+  auto stepFor = [&](double lambda) { return Vector6d(V * a.cwiseQuotient((mu.array() + lambda).matrix())); };
+  TrustStep out;
+  const double scale = std::max(std::abs(mu[5]), 1e-12);
+  if (mu[0] > 1e-9 * scale) {
+    const Vector6d newton = stepFor(0.0);
+    if (newton.norm() <= radius) {
+      out.step = newton.cwiseQuotient(d);
+      out.newton = true;
+      return out;
+    }
+  }
+  // |s(lambda)| falls from infinity (or from its value at -mu_min) to 0 as lambda grows: bisect.
+  double lo = std::max(0.0, -mu[0]) + 1e-12 * scale, hi = lo + 1.0;
+  while (stepFor(hi).norm() > radius) hi = lo + 2.0 * (hi - lo);
+  Vector6d s = stepFor(hi);
+  if (stepFor(lo).norm() < radius) {
+    // The hard case: the gradient has (almost) nothing along the weakest direction; go along it.
+    s = stepFor(lo);
+    const double tau = std::sqrt(std::max(0.0, radius * radius - s.squaredNorm()));
+    s += tau * V.col(0) * (V.col(0).dot(gu) < 0.0 ? -1.0 : 1.0);
+  } else {
+    for (int i = 0; i < 100 && hi - lo > 1e-12 * (1.0 + hi); ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (stepFor(mid).norm() > radius ? lo : hi) = mid;
+    }
+    s = stepFor(hi);
+  }
+  out.step = s.cwiseQuotient(d);
+  return out;
+}
+
 Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& source, Vector6d pose,
                           const NdtConfig& config, NeighbourCache& cache) {
   Optimisation out;
@@ -52,40 +107,39 @@ Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen
   };
   ScoreEvaluation current = evaluate(pose);
   Eigen::Vector3d previous_step = Eigen::Vector3d::Zero();
-  constexpr int kMaxHalvings = 8;
+  // The radius grows to half a voxel at most: the score's model is local to the voxels a point sees.
+  const double max_radius = std::max(config.step_size, 0.5 * config.resolution);
+  double radius = config.step_size;
+  auto scaledNorm = [](const Vector6d& s) { return std::sqrt(s.head<3>().squaredNorm() + kLeverArm * kLeverArm * s.tail<3>().squaredNorm()); };
   while (out.iterations < config.max_iterations) {
-    // The Newton step (pseudo-inverse, as PCL), turned uphill if it points down. Where the Hessian is
-    // indefinite this still aims at the model's stationary point in most directions, which converges far
-    // faster than shifting the Hessian towards a gradient step.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12 misreads Eigen's JacobiSVD internals
-    Eigen::JacobiSVD<Matrix6d> svd(current.hessian, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Vector6d step = svd.solve(-current.gradient);
-#pragma GCC diagnostic pop
-    if (!step.allFinite() || step.norm() == 0.0) {
-      out.converged = true;
+    if (!current.gradient.allFinite() || !current.hessian.allFinite() || current.gradient.norm() == 0.0) {
+      out.converged = true;  // nothing to step on (no point sees a voxel)
       break;
     }
-    if (step.dot(current.gradient) < 0.0) step = -step;
-    const double length = step.norm();
-    if (length > config.step_size) step *= config.step_size / length;
-    const bool small = step.head<3>().squaredNorm() <= config.transformation_epsilon;
-    // Take the longest of step, step/2, step/4, ... that does not lower the score.
-    bool moved = false;
-    int halvings = 0;
-    for (; halvings <= kMaxHalvings; ++halvings, step *= 0.5) {
-      ScoreEvaluation trial = evaluate(pose + step);
-      if (trial.score >= current.score) {
-        pose += step;
-        current = std::move(trial);
-        moved = true;
+    const TrustStep ts = trustRegionStep(current.gradient, current.hessian, radius);
+    const Vector6d& step = ts.step;
+    if (!step.allFinite()) break;
+    const bool small = ts.newton && step.head<3>().squaredNorm() <= config.transformation_epsilon && step.tail<3>().norm() <= kRotationEpsilon;
+    ScoreEvaluation trial = evaluate(pose + step);
+    ++out.iterations;
+    const double gain = trial.score - current.score;
+    const double length = scaledNorm(step);
+    if (!(gain >= 0.0)) {
+      // Refused: the model overreached. Shrink below this step; give up once the smallest fails.
+      radius = 0.25 * std::min(radius, length);
+      if (small || radius < kSmallestRadius) {
+        out.converged = true;
         break;
       }
+      continue;
     }
-    ++out.iterations;
-    // Converged when the full step is already below the threshold, or no ascent is left within 1/256
-    // of it; a step shortened by the search says nothing about convergence.
-    if (!moved || small) {
+    const double predicted = current.gradient.dot(step) + 0.5 * step.dot(current.hessian * step);
+    const double agreement = predicted > 0.0 ? gain / predicted : 0.0;
+    if (agreement > 0.75 && length >= 0.99 * radius) radius = std::min(2.0 * radius, max_radius);
+    else if (agreement < 0.25) radius = std::max(0.25 * length, kSmallestRadius);
+    pose += step;
+    current = std::move(trial);
+    if (small) {
       out.converged = true;
       break;
     }

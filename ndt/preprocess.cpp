@@ -12,6 +12,8 @@ namespace coloc::ndt {
 PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range) {
   PointCloud out;
   const bool times = cloud.hasTimes();
+  out.points.reserve(cloud.size());
+  if (times) out.times.reserve(cloud.size());
   const double lo = min_range * min_range, hi = max_range * max_range;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const double r = cloud.points[i].cast<double>().squaredNorm();
@@ -25,19 +27,24 @@ PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range
 PointCloud deskew(const PointCloud& cloud, double vx, double wz) {
   if (!cloud.hasTimes()) return cloud;
   PointCloud out = cloud;
+  // Where the sensor was at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0). The
+  // lasers of one firing share its time, so the motion is recomputed only when the time changes.
+  double last_t = std::nan(""), dx = 0.0, dy = 0.0, c = 1.0, s = 0.0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const double t = cloud.times[i];
-    const double angle = wz * t;
-    // Where the sensor was at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0).
-    double dx, dy;
-    if (std::abs(wz) < 1e-9) {
-      dx = vx * t;
-      dy = 0.0;
-    } else {
-      dx = vx * std::sin(angle) / wz;
-      dy = vx * (1.0 - std::cos(angle)) / wz;
+    if (!(t == last_t)) {
+      last_t = t;
+      const double angle = wz * t;
+      if (std::abs(wz) < 1e-9) {
+        dx = vx * t;
+        dy = 0.0;
+      } else {
+        dx = vx * std::sin(angle) / wz;
+        dy = vx * (1.0 - std::cos(angle)) / wz;
+      }
+      c = std::cos(angle);
+      s = std::sin(angle);
     }
-    const double c = std::cos(angle), s = std::sin(angle);
     const Eigen::Vector3f& p = cloud.points[i];
     out.points[i] = Eigen::Vector3f(static_cast<float>(c * p.x() - s * p.y() + dx), static_cast<float>(s * p.x() + c * p.y() + dy), p.z());
     out.times[i] = 0.0f;
@@ -56,14 +63,24 @@ PointCloud voxelDownsample(const PointCloud& cloud, double voxel_size) {
   std::vector<Sum> sums;
   const double inverse = 1.0 / voxel_size;
   const bool times = cloud.hasTimes();
+  VoxelCoordinates last_key;
+  std::size_t last_at = 0;
+  bool have_last = false;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d p = cloud.points[i].cast<double>();
     const Eigen::Array3d scaled = (p * inverse).array().floor();
     // A point that is not finite, or too far out for integer voxel coordinates, has no voxel.
     if (!(scaled.abs() < 2e9).all()) continue;
-    const auto [at, inserted] = index.insert({static_cast<std::int32_t>(scaled.x()), static_cast<std::int32_t>(scaled.y()), static_cast<std::int32_t>(scaled.z())});
-    if (inserted) sums.emplace_back();
-    Sum& s = sums[at];
+    const VoxelCoordinates key{static_cast<std::int32_t>(scaled.x()), static_cast<std::int32_t>(scaled.y()), static_cast<std::int32_t>(scaled.z())};
+    // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
+    if (!(have_last && key == last_key)) {
+      const auto [at, inserted] = index.insert(key);
+      if (inserted) sums.emplace_back();
+      last_key = key;
+      last_at = at;
+      have_last = true;
+    }
+    Sum& s = sums[last_at];
     s.point += p;
     if (times) s.time += cloud.times[i];
     ++s.count;

@@ -1,6 +1,8 @@
 #include "coloc/sim/lidar_model.hpp"
 
 #include <cmath>
+#include <memory>
+#include <mutex>
 
 #include "coloc/core/error.hpp"
 #include "coloc/sim/error_sources.hpp"
@@ -42,48 +44,99 @@ LidarSpec withErrors(LidarSpec spec, const ErrorSources& errors) {
   return spec;
 }
 
-std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng) {
+int firingsPerSweep(const LidarSpec& spec) { return static_cast<int>(std::lround(360.0 / spec.azimuth_step_deg)); }
+
+namespace {
+
+// Each ray's direction in the sensor frame, firing-major, for a spec's angles: the same every sweep, so
+// computed once per spec (the trigonometry was a third of a sweep's cost outside the ray casting).
+std::shared_ptr<const std::vector<Eigen::Vector3d>> localDirections(const LidarSpec& spec, int firings) {
+  struct Entry {
+    std::vector<double> vertical, offsets;
+    double step;
+    std::shared_ptr<const std::vector<Eigen::Vector3d>> directions;
+  };
+  static std::mutex mutex;
+  static std::vector<Entry> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const Entry& e : cache)
+    if (e.vertical == spec.vertical_deg && e.offsets == spec.azimuth_offset_deg && e.step == spec.azimuth_step_deg) return e.directions;
   const int lasers = static_cast<int>(spec.vertical_deg.size());
-  const int firings = static_cast<int>(std::lround(360.0 / spec.azimuth_step_deg));
-  const double sweep = 1.0 / spec.rotation_hz;
-  std::vector<Eigen::Vector3f> origins, directions, local_directions;
-  std::vector<float> times;
-  std::vector<int> laser_of;
-  origins.reserve(static_cast<std::size_t>(firings * lasers));
-  directions.reserve(origins.capacity());
+  auto directions = std::make_shared<std::vector<Eigen::Vector3d>>();
+  directions->reserve(static_cast<std::size_t>(firings * lasers));
   for (int f = 0; f < firings; ++f) {
-    const double t = sweep * f / firings;
-    const Eigen::Isometry3d sensor = pose(t);
     const double azimuth = spec.azimuth_step_deg * f;
     for (int l = 0; l < lasers; ++l) {
       const double a = (azimuth + spec.azimuth_offset_deg[l]) * M_PI / 180.0, e = spec.vertical_deg[l] * M_PI / 180.0;
-      const Eigen::Vector3d local(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-      origins.push_back(sensor.translation().cast<float>());
-      directions.push_back((sensor.linear() * local).normalized().cast<float>());
-      local_directions.push_back(local.cast<float>());
-      times.push_back(static_cast<float>(t));
-      laser_of.push_back(l);
+      directions->emplace_back(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+    }
+  }
+  if (cache.size() >= 8) cache.erase(cache.begin());  // a twin uses two or three specs
+  cache.push_back({spec.vertical_deg, spec.azimuth_offset_deg, spec.azimuth_step_deg, directions});
+  return directions;
+}
+
+}  // namespace
+
+std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose) {
+  const int lasers = static_cast<int>(spec.vertical_deg.size());
+  const int firings = firingsPerSweep(spec);
+  const double sweep = 1.0 / spec.rotation_hz;
+  const std::shared_ptr<const std::vector<Eigen::Vector3d>> table = localDirections(spec, firings);
+  const std::vector<Eigen::Vector3d>& local = *table;
+  // Reused between sweeps of a thread: fresh buffers of this size cost page faults every sweep.
+  thread_local std::vector<Eigen::Vector3f> origins, directions;
+  const std::size_t rays = static_cast<std::size_t>(firings * lasers);
+  origins.resize(rays);
+  directions.resize(rays);
+  for (int f = 0; f < firings; ++f) {
+    const double t = sweep * f / firings;
+    const Eigen::Isometry3d sensor = pose(t);
+    const Eigen::Vector3f origin = sensor.translation().cast<float>();
+    for (int l = 0; l < lasers; ++l) {
+      const std::size_t i = static_cast<std::size_t>(f * lasers + l);
+      origins[i] = origin;
+      directions[i] = (sensor.linear() * local[i]).normalized().cast<float>();
     }
   }
   std::vector<RayHit> hits;
   world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
+  return hits;
+}
+
+std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng) {
+  const int lasers = static_cast<int>(spec.vertical_deg.size());
+  const int firings = firingsPerSweep(spec);
+  if (hits.size() != static_cast<std::size_t>(firings * lasers))
+    throw Error("LiDAR sweep: " + std::to_string(hits.size()) + " ray hits for a " + spec.name + " sweep of " + std::to_string(firings * lasers) + " rays");
+  const double sweep = 1.0 / spec.rotation_hz;
+  const std::shared_ptr<const std::vector<Eigen::Vector3d>> table = localDirections(spec, firings);
+  const std::vector<Eigen::Vector3d>& local = *table;
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const bool dropouts = spec.dropout > 0.0 || spec.dropout_at_max_range > 0.0;
   std::vector<LidarPoint> points;
   points.reserve(hits.size() / 2);
-  for (std::size_t i = 0; i < hits.size(); ++i) {
-    // The same draws per ray, hit or not, so that the noise of a point does not depend on the others.
-    const double n = noise(rng);
-    const double u = dropouts ? uniform(rng) : 1.0;
-    if (hits[i].distance < 0.0f) continue;
-    const double r = hits[i].distance;
-    if (dropouts && u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
-    const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
-    if (range < spec.min_range || range > spec.max_range) continue;
-    points.push_back({static_cast<float>(range) * local_directions[i], times[i], laser_of[i], hits[i].mesh});
+  for (int f = 0; f < firings; ++f) {
+    const float time = static_cast<float>(sweep * f / firings);
+    for (int l = 0; l < lasers; ++l) {
+      const std::size_t i = static_cast<std::size_t>(f * lasers + l);
+      // The same draws per ray, hit or not, so that the noise of a point does not depend on the others.
+      const double n = noise(rng);
+      const double u = dropouts ? uniform(rng) : 1.0;
+      if (hits[i].distance < 0.0f) continue;
+      const double r = hits[i].distance;
+      if (dropouts && u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
+      const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
+      if (range < spec.min_range || range > spec.max_range) continue;
+      points.push_back({static_cast<float>(range) * local[i].cast<float>(), time, l, hits[i].mesh});
+    }
   }
   return points;
+}
+
+std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng) {
+  return sweepPoints(spec, castSweep(spec, world, pose), rng);
 }
 
 }  // namespace coloc::sim

@@ -309,9 +309,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     scene.place(capture, nullptr);
     const auto c0 = Clock::now();
     // The LiDAR as mounted, which its recorded extrinsic (yaw 0) misses by errors.lidar_mount_yaw.
-    const auto sweep = sim::scanSweep(roof, scene.caster(), [&](double dt) {
+    const sim::SensorTrajectory roof_pose = [&](double dt) {
       return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height) * Eigen::AngleAxisd(errors.lidar_mount_yaw, Eigen::Vector3d::UnitZ());
-    }, rng);
+    };
+    auto cast = [&] { return sim::castSweep(roof, scene.caster(), roof_pose); };
+    const auto sweep = options.roof_sweeps
+                           ? sim::sweepPoints(roof, *options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast), rng)
+                           : sim::sweepPoints(roof, cast(), rng);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
     const io::Bytes b = io::encodePointCloud2(toPointCloud2(sweep, at(t)));
@@ -329,7 +333,18 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const Eigen::Isometry3d pose = Eigen::Translation3d(r.info.position.x(), r.info.position.y(), r.info.height) *
                                      Eigen::AngleAxisd(r.info.yaw, Eigen::Vector3d::UnitZ());
       const auto c1 = Clock::now();
-      const std::vector<Eigen::Vector3f> frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);
+      std::vector<Eigen::Vector3f> frame;
+      if (options.rsu_frames) {
+        // Keyed by RSU and sweep; the fingerprint adds where the vehicle is, which the world holds.
+        const sim::SensorTrajectory still = [&](double) { return pose; };
+        const double ego[3] = {seen.position.x(), seen.position.y(), seen.yaw};
+        const std::uint64_t key = (static_cast<std::uint64_t>(&r - rsus.data()) << 32) | summary.scans;
+        const auto hits = options.rsu_frames->get(key, sim::sweepFingerprint(r.lidar, still, ego, 3),
+                                                  [&] { return sim::castSweep(r.lidar, with_vehicle.caster(), still); });
+        for (const auto& p : sim::sweepPoints(r.lidar, *hits, rng)) frame.push_back(p.position);
+      } else {
+        frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);
+      }
       summary.ray_casting_seconds += since(c1);
       summary.rays += raysPerSweep(r.lidar);
       // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.

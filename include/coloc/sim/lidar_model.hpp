@@ -50,4 +50,12 @@ using SensorTrajectory = std::function<Eigen::Isometry3d(double t)>;
 /// scan carries the motion distortion a real one has. Noise is drawn from `rng`.
 std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng);
 
+/// scanSweep in its two halves. The geometry: every ray's hit, firing-major, lasers in spec order...
+std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose);
+/// ...and the points those hits give with the spec's noise and dropouts drawn from `rng` (two draws per
+/// ray, hit or not). Throws coloc::Error if `hits` is not a sweep of this spec.
+std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng);
+/// Firings in one revolution (360 deg / azimuth step).
+int firingsPerSweep(const LidarSpec& spec);
+
 }  // namespace coloc::sim

@@ -13,6 +13,7 @@
 #include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
+#include "coloc/sim/sweep_cache.hpp"
 #include "coloc/sim/roadside_perception.hpp"
 #include "coloc/sim/scene.hpp"
 
@@ -32,6 +33,12 @@ struct TwinRecordingOptions {
   /// range noise, no dropouts) and fix it: the fix error the error sources cost, paired frame by frame.
   bool ideal_comparison = false;
   std::function<void(double)> progress;  ///< share of the drive done
+  /// The roof LiDAR's ray hits shared with other drives of the same scenario's world (trials differ in
+  /// their draws, not in what the rays hit); none: every sweep is cast.
+  std::shared_ptr<sim::SweepCache> roof_sweeps;
+  /// The same for the RSUs' frames (the RSUs' true poses, the vehicle's path and the traffic are the
+  /// same on every trial; their survey errors are not where the LiDARs are, only where the registry says).
+  std::shared_ptr<sim::SweepCache> rsu_frames;
 };
 
 /// One RSU frame within coverage: what the perception made of it.

@@ -1,0 +1,60 @@
+#include "coloc/sim/sweep_cache.hpp"
+
+#include <cstring>
+
+namespace coloc::sim {
+
+namespace {
+
+// FNV-1a over raw bytes: a fingerprint, not a defence against crafted input.
+void mix(std::uint64_t& h, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) h = (h ^ bytes[i]) * 1099511628211ULL;
+}
+
+}  // namespace
+
+std::uint64_t sweepFingerprint(const LidarSpec& spec, const SensorTrajectory& pose, const double* world, std::size_t count) {
+  std::uint64_t h = 14695981039346656037ULL;
+  if (count > 0) mix(h, world, count * sizeof(double));
+  mix(h, spec.vertical_deg.data(), spec.vertical_deg.size() * sizeof(double));
+  mix(h, spec.azimuth_offset_deg.data(), spec.azimuth_offset_deg.size() * sizeof(double));
+  for (double v : {spec.rotation_hz, spec.azimuth_step_deg, spec.max_range}) mix(h, &v, sizeof v);
+  const int firings = firingsPerSweep(spec);
+  const double sweep = 1.0 / spec.rotation_hz;
+  for (int f = 0; f < firings; ++f) {
+    const Eigen::Isometry3d p = pose(sweep * f / firings);  // the very times castSweep uses
+    mix(h, p.matrix().data(), 16 * sizeof(double));
+  }
+  return h;
+}
+
+std::shared_ptr<const SweepCache::Hits> SweepCache::get(std::size_t index, std::uint64_t fingerprint, const std::function<Hits()>& cast) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto found = entries_.find(index);
+    if (found != entries_.end() && found->second.fingerprint == fingerprint) {
+      ++stats_.served;
+      return found->second.hits;
+    }
+  }
+  auto hits = std::make_shared<const Hits>(cast());
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++stats_.cast;
+  entries_.emplace(index, Entry{fingerprint, hits});  // keeps the first drive's sweep if one is there
+  return hits;
+}
+
+SweepCacheStats SweepCache::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+std::size_t SweepCache::bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t total = 0;
+  for (const auto& [index, e] : entries_) total += e.hits->size() * sizeof(RayHit);
+  return total;
+}
+
+}  // namespace coloc::sim
