@@ -191,9 +191,8 @@ AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, cons
     return result;
   }
   const auto start = Clock::now();
-  // Which voxels each point can reach, remembered across the evaluations of this alignment. The margin
-  // trades list length against regathering: a quarter voxel outlasts several clamped Newton steps.
-  NeighbourCache cache(source.size(), config.resolution, 0.25 * config.resolution);
+  // Which voxels each point can reach, remembered across the evaluations of this alignment.
+  NeighbourCache cache(source.size(), config.resolution);
   const bool fast = config.backend == NdtBackend::kFast;
   const Optimisation opt = fast ? optimiseFast(t, source.points, matrixToPose(guess), config, cache) : optimisePcl(t, source, guess);
   result.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();

@@ -61,43 +61,24 @@ const std::vector<Eigen::Vector3i>& offsets(Neighborhood n) {
   return cube27;
 }
 
-// Gathers the voxels whose means lie within resolution + margin of xt, in the order a 27-cell search
-// from any cell visits them (lexicographic in cell coordinates: x, then y, then z). Returns their
-// count, or NeighbourCache's overflow mark.
-template <int kMax>
-std::uint8_t gatherNeighbours(const VoxelLookup& voxels, double resolution, double margin, const Vector3d& xt, std::uint32_t* out) {
-  const double reach = resolution + margin, reach_sq = reach * reach;
-  const Vector3d scaled = xt / resolution;
-  const Eigen::Vector3i base = scaled.array().floor().cast<int>();
-  const Vector3d frac = scaled - base.cast<double>();
-  // Distance along one axis from the point to the cell at offset d (cells are half-open boxes; a mean
-  // lies in its cell's box). The reach is under two resolutions, so offsets of +-2 cover it.
-  auto axis = [&](int d, double u) { return d == 0 ? 0.0 : (d > 0 ? (d - u) : (u + (-d - 1))) * resolution; };
-  const double slack = 1e-6 * resolution;  // a mean rounded to just outside its box
-  int n = 0;
-  for (int dx = -2; dx <= 2; ++dx) {
-    const double ax = std::max(0.0, axis(dx, frac.x()) - slack);
-    if (ax * ax > reach_sq) continue;
-    for (int dy = -2; dy <= 2; ++dy) {
-      const double ay = std::max(0.0, axis(dy, frac.y()) - slack);
-      if (ax * ax + ay * ay > reach_sq) continue;
-      for (int dz = -2; dz <= 2; ++dz) {
-        const double az = std::max(0.0, axis(dz, frac.z()) - slack);
-        if (ax * ax + ay * ay + az * az > reach_sq) continue;
-        const std::int64_t v = voxels.indexOf(base + Eigen::Vector3i(dx, dy, dz));
-        if (v < 0 || (xt - voxels.voxels()[static_cast<std::size_t>(v)].mean).squaredNorm() > reach_sq) continue;
-        if (n == kMax) return NeighbourCache::kOverflow;
-        out[n++] = static_cast<std::uint32_t>(v);
-      }
-    }
+// Appends the voxels of cell's 27-cell block whose means lie within one resolution of the cell's box,
+// in the 27-cell search's order. A point in the cell is nearer to a mean than the box is, so no voxel
+// within reach of a point is left out (the slack covers a point rounded onto the cell from outside).
+void gatherCell(const VoxelLookup& voxels, double resolution, const Eigen::Vector3i& cell, std::vector<std::uint32_t>& out) {
+  const Vector3d low = cell.cast<double>() * resolution, high = low + Vector3d::Constant(resolution);
+  const double reach = resolution * (1.0 + 1e-6), reach_sq = reach * reach;
+  for (const Eigen::Vector3i& offset : offsets(Neighborhood::kRadius)) {
+    const std::int64_t v = voxels.indexOf(cell + offset);
+    if (v < 0) continue;
+    const Vector3d& mean = voxels.voxels()[static_cast<std::size_t>(v)].mean;
+    if ((mean.cwiseMax(low).cwiseMin(high) - mean).squaredNorm() <= reach_sq) out.push_back(static_cast<std::uint32_t>(v));
   }
-  return static_cast<std::uint8_t>(n);
 }
 
 }  // namespace
 
-NeighbourCache::NeighbourCache(std::size_t points, double resolution, double margin)
-    : resolution_(resolution), margin_(margin), at_(points), count_(points, kUnset), candidates_(points * kMaxCandidates) {}
+NeighbourCache::NeighbourCache(std::size_t points, double resolution)
+    : resolution_(resolution), cell_(points, kNoCell), list_(points, 0), thread_(points, -1) {}
 
 ScoreConstants scoreConstants(double resolution, double outlier_ratio) {
   // The mixture of a Gaussian and a uniform outlier density, approximated by one scaled Gaussian.
@@ -136,27 +117,32 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
   const std::vector<Eigen::Vector3i>& search = offsets(options.neighborhood);
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   const long n = static_cast<long>(source.size());
-  if (cache && (cache->at_.size() != source.size() || cache->resolution_ != resolution)) cache = nullptr;  // not this alignment's
+  if (cache && (cache->cell_.size() != source.size() || cache->resolution_ != resolution)) cache = nullptr;  // not this alignment's
+  if (cache && cache->lists_.size() < static_cast<std::size_t>(threads)) cache->lists_.resize(static_cast<std::size_t>(threads));
   const bool cached_search = cache && options.neighborhood == Neighborhood::kRadius;
-  const double margin_sq = cache ? cache->margin_ * cache->margin_ : 0.0;
-  // Calls visit(voxel) for every voxel of the radius neighbourhood's 27 cells, from the cache when
-  // the point is still near where its list was gathered.
-  auto forRadius = [&](long idx, const Vector3d& xt, const Eigen::Vector3i& cell, auto&& visit) {
-    if (cache) {
-      const std::size_t i = static_cast<std::size_t>(idx);
-      std::uint8_t& count = cache->count_[i];
-      std::uint32_t* list = &cache->candidates_[i * NeighbourCache::kMaxCandidates];
-      if (count == NeighbourCache::kUnset || (count != NeighbourCache::kOverflow && (xt - cache->at_[i]).squaredNorm() > margin_sq)) {
-        count = gatherNeighbours<NeighbourCache::kMaxCandidates>(voxels, resolution, cache->margin_, xt, list);
-        cache->at_[i] = xt;
-      }
-      if (count != NeighbourCache::kOverflow) {
-        for (int c = 0; c < count; ++c) visit(voxels.voxels()[list[c]]);
-        return;
-      }
+  // Calls visit(voxel) for every voxel of the radius neighbourhood's 27 cells that can be within reach,
+  // from the cache when there is one.
+  auto forRadius = [&](long idx, const Eigen::Vector3i& cell, int thread, auto&& visit) {
+    if (!cache) {
+      for (const Eigen::Vector3i& offset : offsets(Neighborhood::kRadius))
+        if (const Voxel* v = voxels.find(cell + offset)) visit(*v);
+      return;
     }
-    for (const Eigen::Vector3i& offset : offsets(Neighborhood::kRadius))
-      if (const Voxel* v = voxels.find(cell + offset)) visit(*v);
+    const std::size_t i = static_cast<std::size_t>(idx);
+    NeighbourCache::Lists& lists = cache->lists_[static_cast<std::size_t>(thread)];
+    const std::uint64_t key = VoxelLookup::pack(cell);
+    if (cache->cell_[i] != key || cache->thread_[i] != thread) {
+      const auto [list, inserted] = lists.cells.insert(key);
+      if (inserted) {
+        gatherCell(voxels, resolution, cell, lists.voxels);
+        lists.begin.push_back(static_cast<std::uint32_t>(lists.voxels.size()));
+      }
+      cache->cell_[i] = key;
+      cache->list_[i] = static_cast<std::uint32_t>(list);
+      cache->thread_[i] = thread;
+    }
+    const std::uint32_t n = cache->list_[i];
+    for (std::uint32_t k = lists.begin[n]; k < lists.begin[n + 1]; ++k) visit(voxels.voxels()[lists.voxels[k]]);
   };
 
   // One partial sum per thread, added in thread order afterwards: with a static schedule the result is
@@ -164,7 +150,8 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
   std::vector<ScoreEvaluation> partial(static_cast<std::size_t>(threads));
 #pragma omp parallel num_threads(threads)
   {
-    ScoreEvaluation& local = partial[static_cast<std::size_t>(omp_get_thread_num())];
+    const int thread = omp_get_thread_num();
+    ScoreEvaluation& local = partial[static_cast<std::size_t>(thread)];
 #pragma omp for schedule(static) nowait
     for (long idx = 0; idx < n; ++idx) {
       const Vector3d x = source[static_cast<std::size_t>(idx)].cast<double>();
@@ -182,16 +169,20 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
         const Vector3d q = xt - v.mean;
         if (options.neighborhood == Neighborhood::kRadius && q.squaredNorm() > radius_sq) return;
         const Vector3d Cq = v.inverse_covariance * q;
-        const double e = std::exp(-0.5 * k.d2 * q.dot(Cq));
-        point_score += -k.d1 * e;
+        const double exponent = -0.5 * k.d2 * q.dot(Cq);
         any = true;
+        // Beyond e^-40 (4e-18 of a voxel's full weight) a term cannot change a double sum of terms up
+        // to 1: skipping it saves the exp and the derivatives of the many voxels a point barely touches.
+        if (exponent < -40.0) return;
+        const double e = std::exp(exponent);
+        point_score += -k.d1 * e;
         if (!options.gradient) return;
         const double f = k.d1 * k.d2 * e;
         b += f * Cq;
         if (options.hessian) A.noalias() += f * (v.inverse_covariance - k.d2 * Cq * Cq.transpose());
       };
       if (cached_search) {
-        forRadius(idx, xt, cell, visit);
+        forRadius(idx, cell, thread, visit);
       } else {
         for (const Eigen::Vector3i& offset : search)
           if (const Voxel* v = voxels.find(cell + offset)) visit(*v);
@@ -215,7 +206,7 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
       if (options.nvtl) {
         double best = 0.0;
         bool found = false;
-        forRadius(idx, xt, cell, [&](const Voxel& v) {
+        forRadius(idx, cell, thread, [&](const Voxel& v) {
           const Vector3d q = xt - v.mean;
           if (q.squaredNorm() > radius_sq) return;
           const double s = -k.d1 * std::exp(-0.5 * k.d2 * q.dot(v.inverse_covariance * q));

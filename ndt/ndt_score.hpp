@@ -11,6 +11,7 @@
 
 #include "coloc/core/types.hpp"
 #include "coloc/ndt/ndt_config.hpp"
+#include "voxel_index.hpp"
 #include "voxel_lookup.hpp"
 
 namespace coloc::ndt {
@@ -38,21 +39,26 @@ struct ScoreEvaluation {
   std::size_t nvtl_points = 0; ///< points with at least one voxel in reach
 };
 
-/// What one alignment remembers between evaluations of the radius neighbourhood: for each source
-/// point, the voxels whose means lay within resolution + margin of where the point was last gathered.
-/// While a point stays within `margin` of that place, every voxel within one resolution of it is on
-/// its list, which is kept in the order the 27-cell search visits voxels, so the sums are the same
-/// bits as without the cache; a point that moved farther is gathered again. Saves the 27 hash probes
-/// per point and evaluation that otherwise dominate an evaluation.
+/// What one alignment remembers between evaluations of the radius neighbourhood: per target cell that
+/// a source point fell into, the voxels of its 27-cell block whose means lie within one resolution of
+/// the cell (the only ones a point inside it can reach), in the order the 27-cell search visits them;
+/// and per point, its cell at the last evaluation. A point still in the same cell costs no hash probe,
+/// a point in a cell seen before costs one, and a new cell's list is gathered once for all the points
+/// in it (about ten of a dense scan's). The sums are the same bits as without the cache.
 struct NeighbourCache {
-  NeighbourCache(std::size_t points, double resolution, double margin);
+  NeighbourCache(std::size_t points, double resolution);
 
-  static constexpr int kMaxCandidates = 48;
-  static constexpr std::uint8_t kUnset = 255, kOverflow = 254;
-  double resolution_, margin_;
-  std::vector<Eigen::Vector3d> at_;
-  std::vector<std::uint8_t> count_;
-  std::vector<std::uint32_t> candidates_;  ///< kMaxCandidates per point
+  struct Lists {                            ///< one per thread: the cells its points fell into
+    PackedVoxelIndex cells;                 ///< packed cell -> list number
+    std::vector<std::uint32_t> begin{0};    ///< list n is voxels[begin[n], begin[n + 1])
+    std::vector<std::uint32_t> voxels;      ///< indices into VoxelLookup::voxels()
+  };
+  static constexpr std::uint64_t kNoCell = ~0ULL;
+  double resolution_;
+  std::vector<std::uint64_t> cell_;  ///< per point: its packed cell at the last evaluation
+  std::vector<std::uint32_t> list_;  ///< per point: that cell's list in its thread's Lists
+  std::vector<int> thread_;          ///< per point: that thread
+  std::vector<Lists> lists_;
 };
 
 /// `cache` (radius neighbourhood only; else ignored): the alignment's memory of each point's voxels.

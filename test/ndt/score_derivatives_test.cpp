@@ -50,9 +50,9 @@ TEST(NdtScore, GradientAndHessianMatchNumericDerivatives) {
 }
 
 TEST(NdtScore, TheNeighbourCacheGivesTheSameBitsAsTheFullSearchWhereverThePointsMove) {
-  // A dense random field of voxels (every cell, means anywhere in their cells) and points spread over
-  // it; the pose then walks away step by step, so that points regather after a quarter voxel and cross
-  // cells. Every evaluation must equal the uncached one exactly, NVTL included.
+  // A dense random field of voxels (most cells, means anywhere in their cells) and points spread over
+  // it; the pose then walks away step by step, so that points cross cells into ones seen before and new
+  // ones. Every evaluation must equal the uncached one exactly, NVTL included, on one thread and on two.
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   VoxelLookup voxels;
@@ -71,9 +71,10 @@ TEST(NdtScore, TheNeighbourCacheGivesTheSameBitsAsTheFullSearchWhereverThePoints
   const ScoreConstants k = scoreConstants(2.0, 0.55);
   ScoreOptions options;
   options.nvtl = true;
-  NeighbourCache cache(source.size(), 2.0, 0.5);
+  NeighbourCache cache(source.size(), 2.0);
   Vector6d pose = Vector6d::Zero();
   for (int step = 0; step < 40; ++step) {
+    options.threads = 1 + step % 2;
     pose += (Vector6d() << 0.07, -0.05, 0.03, 0.004, -0.003, 0.01).finished();
     const ScoreEvaluation plain = evaluateScore(voxels, 2.0, k, source, pose, options);
     const ScoreEvaluation cached = evaluateScore(voxels, 2.0, k, source, pose, options, &cache);
