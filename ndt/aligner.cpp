@@ -96,29 +96,26 @@ TrustStep trustRegionStep(const Vector6d& gradient, const Matrix6d& hessian, dou
   return out;
 }
 
-Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& source, Vector6d pose,
-                          const NdtConfig& config, NeighbourCache& cache) {
-  Optimisation out;
+// The trust-region iterations on `points` from `pose` with radius `radius` (both carried on), counted
+// into `out` up to the iteration limit. True when converged (see above).
+bool iterate(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& points, const NdtConfig& config, NeighbourCache& cache,
+             Vector6d& pose, double& radius, Eigen::Vector3d& previous_step, Optimisation& out) {
   ScoreOptions options;
   options.neighborhood = config.neighborhood;
   options.threads = config.threads;
   auto evaluate = [&](const Vector6d& p) {
-    return evaluateScore(target.voxels, config.resolution, target.constants, source, p, options, &cache);
+    return evaluateScore(target.voxels, config.resolution, target.constants, points, p, options, &cache);
   };
   ScoreEvaluation current = evaluate(pose);
-  Eigen::Vector3d previous_step = Eigen::Vector3d::Zero();
   // The radius grows to half a voxel at most: the score's model is local to the voxels a point sees.
   const double max_radius = std::max(config.step_size, 0.5 * config.resolution);
-  double radius = config.step_size;
   auto scaledNorm = [](const Vector6d& s) { return std::sqrt(s.head<3>().squaredNorm() + kLeverArm * kLeverArm * s.tail<3>().squaredNorm()); };
   while (out.iterations < config.max_iterations) {
-    if (!current.gradient.allFinite() || !current.hessian.allFinite() || current.gradient.norm() == 0.0) {
-      out.converged = true;  // nothing to step on (no point sees a voxel)
-      break;
-    }
+    if (!current.gradient.allFinite() || !current.hessian.allFinite() || current.gradient.norm() == 0.0)
+      return true;  // nothing to step on (no point sees a voxel)
     const TrustStep ts = trustRegionStep(current.gradient, current.hessian, radius);
     const Vector6d& step = ts.step;
-    if (!step.allFinite()) break;
+    if (!step.allFinite()) return false;
     const bool small = ts.newton && step.head<3>().squaredNorm() <= config.transformation_epsilon && step.tail<3>().norm() <= kRotationEpsilon;
     ScoreEvaluation trial = evaluate(pose + step);
     ++out.iterations;
@@ -127,10 +124,7 @@ Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen
     if (!(gain >= 0.0)) {
       // Refused: the model overreached. Shrink below this step; give up once the smallest fails.
       radius = 0.25 * std::min(radius, length);
-      if (small || radius < kSmallestRadius) {
-        out.converged = true;
-        break;
-      }
+      if (small || radius < kSmallestRadius) return true;
       continue;
     }
     const double predicted = current.gradient.dot(step) + 0.5 * step.dot(current.hessian * step);
@@ -139,16 +133,36 @@ Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen
     else if (agreement < 0.25) radius = std::max(0.25 * length, kSmallestRadius);
     pose += step;
     current = std::move(trial);
-    if (small) {
-      out.converged = true;
-      break;
-    }
+    if (small) return true;
     const Eigen::Vector3d translation = step.head<3>();
     if (previous_step.norm() > 0.0 && translation.norm() > 0.0 &&
         previous_step.dot(translation) / (previous_step.norm() * translation.norm()) < -0.9)
       ++out.oscillations;
     previous_step = translation;
   }
+  return false;
+}
+
+// A dense scan first converges on an evenly spread subset of kCoarsePoints points, then on all of them:
+// far from the optimum every point only repeats what its neighbours say, and the last, full-resolution
+// iterations start next to the optimum (16k points: 9 full evaluations become 3 or 4). Scans of
+// Autoware's size (1,500 points) never take the first stage.
+constexpr std::size_t kCoarsePoints = 4000;
+
+Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& source, Vector6d pose,
+                          const NdtConfig& config, NeighbourCache& cache) {
+  Optimisation out;
+  double radius = config.step_size;
+  Eigen::Vector3d previous_step = Eigen::Vector3d::Zero();
+  if (source.size() >= 2 * kCoarsePoints) {
+    const std::size_t stride = source.size() / kCoarsePoints;
+    std::vector<Eigen::Vector3f> coarse;
+    coarse.reserve(source.size() / stride + 1);
+    for (std::size_t i = 0; i < source.size(); i += stride) coarse.push_back(source[i]);
+    NeighbourCache coarse_cache(coarse.size(), config.resolution);
+    iterate(target, coarse, config, coarse_cache, pose, radius, previous_step, out);
+  }
+  out.converged = iterate(target, source, config, cache, pose, radius, previous_step, out);
   out.pose = pose;
   return out;
 }

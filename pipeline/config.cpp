@@ -175,7 +175,7 @@ const std::vector<Key>& keys() {
          c.ndt.source.ndt.neighborhood = v == "radius" ? Neighborhood::kRadius : v == "face7" ? Neighborhood::kFace7 : Neighborhood::kSingle; }},
       {"ndt", "resolution", "m", "NDT voxel size of the map", [](const C& c) { return show(c.ndt.source.ndt.resolution); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.resolution = r.number(n, k); }},
-      {"ndt", "step_size", "m", "longest Newton step", [](const C& c) { return show(c.ndt.source.ndt.step_size); },
+      {"ndt", "step_size", "m", "first trust-region radius (Autoware's longest step); it grows while steps succeed", [](const C& c) { return show(c.ndt.source.ndt.step_size); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.step_size = r.number(n, k); }},
       {"ndt", "transformation_epsilon", "m^2", "stop when the squared translation of a step is below this (PCL's meaning; Autoware's 0.01 is 1e-4 here)",
        [](const C& c) { return show(c.ndt.source.ndt.transformation_epsilon); },

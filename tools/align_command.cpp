@@ -31,7 +31,7 @@ void addAlignCommand(CLI::App& app) {
   cmd->add_option("--neighborhood", neighborhood, "fast backend: radius, face7 or single")
       ->check(CLI::IsMember({"radius", "face7", "single"}))->capture_default_str();
   cmd->add_option("--resolution", resolution, "target voxel size, m")->capture_default_str();
-  cmd->add_option("--step-size", step, "longest Newton step, m")->capture_default_str();
+  cmd->add_option("--step-size", step, "first trust-region radius (Autoware's longest step), m")->capture_default_str();
   cmd->add_option("--epsilon", epsilon, "stop when the squared step translation is below this, m^2")->capture_default_str();
   cmd->add_option("--max-iterations", iterations, "iteration limit")->capture_default_str();
   cmd->add_option("--source-voxel", source_voxel, "voxel size the source is downsampled with, m (0 = none)")->capture_default_str();

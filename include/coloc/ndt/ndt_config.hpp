@@ -26,7 +26,7 @@ struct NdtConfig {
   NdtBackend backend = NdtBackend::kFast;
   Neighborhood neighborhood = Neighborhood::kRadius;
   double resolution = 2.0;     ///< m, voxel size of the target
-  double step_size = 0.1;      ///< m, longest Newton step
+  double step_size = 0.1;      ///< m, the trust region's first radius (Autoware's longest step); grows while steps succeed
   /// PCL's criterion: stop when the squared translation of a step is below this. Autoware's
   /// trans_epsilon 0.01 is a 6-D step norm; its equivalent here is 1e-4 (1 cm).
   double transformation_epsilon = 1e-4;
