@@ -24,9 +24,11 @@ PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range
   return out;
 }
 
-PointCloud deskew(const PointCloud& cloud, double vx, double wz) {
-  if (!cloud.hasTimes()) return cloud;
-  PointCloud out = cloud;
+namespace {
+
+// deskew() on a cloud of one's own, without the copy (preprocessScan's cropped cloud is its own).
+void deskewInPlace(PointCloud& cloud, double vx, double wz) {
+  if (!cloud.hasTimes()) return;
   // Where the sensor was at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0). The
   // lasers of one firing share its time, so the motion is recomputed only when the time changes.
   double last_t = std::nan(""), dx = 0.0, dy = 0.0, c = 1.0, s = 0.0;
@@ -45,10 +47,17 @@ PointCloud deskew(const PointCloud& cloud, double vx, double wz) {
       c = std::cos(angle);
       s = std::sin(angle);
     }
-    const Eigen::Vector3f& p = cloud.points[i];
-    out.points[i] = Eigen::Vector3f(static_cast<float>(c * p.x() - s * p.y() + dx), static_cast<float>(s * p.x() + c * p.y() + dy), p.z());
-    out.times[i] = 0.0f;
+    const Eigen::Vector3f p = cloud.points[i];
+    cloud.points[i] = Eigen::Vector3f(static_cast<float>(c * p.x() - s * p.y() + dx), static_cast<float>(s * p.x() + c * p.y() + dy), p.z());
+    cloud.times[i] = 0.0f;
   }
+}
+
+}  // namespace
+
+PointCloud deskew(const PointCloud& cloud, double vx, double wz) {
+  PointCloud out = cloud;
+  deskewInPlace(out, vx, wz);
   return out;
 }
 
@@ -117,7 +126,7 @@ PointCloud capPoints(const PointCloud& cloud, std::size_t max_points, std::uint3
 
 PointCloud preprocessScan(const PointCloud& scan, const PreprocessConfig& config, double vx, double wz) {
   PointCloud cloud = cropRange(scan, config.min_range, config.max_range);
-  if (config.deskew) cloud = deskew(cloud, vx, wz);
+  if (config.deskew) deskewInPlace(cloud, vx, wz);
   cloud = voxelDownsample(cloud, config.voxel_size);
   return capPoints(cloud, config.max_points, config.seed);
 }
