@@ -8,12 +8,13 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
-#include <random>
+#include <algorithm>
 
 #include "coloc/ndt/aligner.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/preprocess.hpp"
 #include "real_data.hpp"
+#include "seeded_starts.hpp"
 
 using namespace coloc;
 using namespace coloc::ndt;
@@ -27,23 +28,13 @@ struct Outcome {
 
 Outcome basin(const NdtTarget& target, const PointCloud& source, const Eigen::Matrix4d& reference, double metres, double degrees,
               const NdtConfig& config) {
-  std::mt19937 rng(20);
-  std::uniform_real_distribution<double> direction(-M_PI, M_PI);
-  std::bernoulli_distribution sign(0.5);
   Outcome out;
   std::vector<int> iterations;
-  for (int i = 0; i < 20; ++i) {
-    const double heading = direction(rng);
-    const double yaw = (sign(rng) ? 1.0 : -1.0) * degrees * M_PI / 180.0;
-    Eigen::Matrix4d guess = reference;
-    guess.topLeftCorner<3, 3>() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * reference.topLeftCorner<3, 3>();
-    guess.topRightCorner<3, 1>() += metres * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0.0);
+  for (const Eigen::Matrix4d& guess : testing::seededStarts(reference, metres, degrees)) {
     const AlignResult r = align(target, source, guess, config);
-    const double cm = 100.0 * (r.transform.topRightCorner<3, 1>() - reference.topRightCorner<3, 1>()).norm();
-    const Eigen::Matrix3d dR = r.transform.topLeftCorner<3, 3>() * reference.topLeftCorner<3, 3>().transpose();
-    const double deg = Eigen::AngleAxisd(dR).angle() * 180.0 / M_PI;
-    if (cm <= 5.0 && deg <= 0.5) ++out.converged;
-    out.worst_cm = std::max(out.worst_cm, cm);
+    const auto [m, deg] = testing::poseDifference(r.transform, reference);
+    if (m <= 0.05 && deg <= 0.5) ++out.converged;
+    out.worst_cm = std::max(out.worst_cm, 100.0 * m);
     iterations.push_back(r.iterations);
   }
   std::sort(iterations.begin(), iterations.end());

@@ -27,10 +27,11 @@ struct Event {
   Stamp arrival;  ///< log_time on the stamp clock
   std::uint64_t order;
   std::size_t topic;
-  std::variant<PoseMeasurement, TwistMeasurement, std::shared_ptr<const ndt::PointCloud>, rsu_client::RsuFix> input;
+  /// A scan is owned when decoded from the file, shared when it comes from a ReplayCache.
+  std::variant<PoseMeasurement, TwistMeasurement, ndt::PointCloud, std::shared_ptr<const ndt::PointCloud>, rsu_client::RsuFix> input;
 };
 
-using ScanPtr = std::shared_ptr<const ndt::PointCloud>;
+using SharedScan = std::shared_ptr<const ndt::PointCloud>;
 
 // The log's messages in order, from the file or from a log held in memory (ReplayCache).
 class MessageSource {
@@ -42,11 +43,18 @@ class MessageSource {
     if (bag_) return bag_->next(message_) ? &message_ : nullptr;
     return next_ < log_->messages().size() ? &log_->messages()[next_++] : nullptr;
   }
-  RecordedLog::Scan scan(const io::BagMessage& m, io::MessageKind kind) const {
-    if (log_) return log_->scan(m.index, kind);
+  /// Message m as a point cloud (PointCloud2 as `kind`) into `e`: shared from the log in memory, or decoded.
+  void scan(const io::BagMessage& m, io::MessageKind kind, Event& e) const {
+    if (log_) {
+      RecordedLog::Scan shared = log_->scan(m.index, kind);
+      e.stamp = shared.stamp;
+      e.input = std::move(shared.cloud);
+      return;
+    }
     const io::RosMessage decoded = io::decodeMessage(kind, m.data);
     const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
-    return {cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud))};
+    e.stamp = cloud.header.stamp;
+    e.input = pipeline::toPointCloud(cloud);
   }
 
  private:
@@ -87,9 +95,7 @@ std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& conf
     try {
       Event e{message.log_time, 0, 0, message.index, ti, PoseMeasurement{}};
       if (use.role == InputRole::kScan) {
-        RecordedLog::Scan scan = source.scan(message, *use.kind);
-        e.stamp = scan.stamp;
-        e.input = std::move(scan.cloud);
+        source.scan(message, *use.kind, e);
         events.push_back(std::move(e));
         continue;
       }
@@ -115,7 +121,8 @@ std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& conf
       // The measurement's own stamp, moved back by the configured sensing delay.
       std::visit(
           [&](auto& m) {
-            if constexpr (!std::is_same_v<std::decay_t<decltype(m)>, ScanPtr>) {
+            using M = std::decay_t<decltype(m)>;
+            if constexpr (!std::is_same_v<M, ndt::PointCloud> && !std::is_same_v<M, SharedScan>) {
               if (input && input->additional_delay > 0.0) m.stamp -= fromSeconds(input->additional_delay);
               e.stamp = m.stamp;
             }
@@ -226,12 +233,10 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   });
   for (std::size_t i = 0; i < events.size(); ++i) {
     Event& e = events[i];
-    if (options.progress && (i % 256 == 0 || std::holds_alternative<ScanPtr>(e.input)))
-      options.progress(0.5 + 0.5 * i / events.size());
-    if (auto* scan = std::get_if<ScanPtr>(&e.input)) {
-      pipe.pushScan(ndt::PointCloud(**scan), e.stamp, e.arrival);
-      scan->reset();  // a scan not shared with other replays is released once matched
-    }
+    const bool is_scan = std::holds_alternative<ndt::PointCloud>(e.input) || std::holds_alternative<SharedScan>(e.input);
+    if (options.progress && (i % 256 == 0 || is_scan)) options.progress(0.5 + 0.5 * i / events.size());
+    if (auto* scan = std::get_if<ndt::PointCloud>(&e.input)) pipe.pushScan(std::move(*scan), e.stamp, e.arrival);
+    else if (auto* shared = std::get_if<SharedScan>(&e.input)) pipe.pushScan(ndt::PointCloud(**shared), e.stamp, e.arrival);
     else if (auto* fix = std::get_if<rsu_client::RsuFix>(&e.input)) pipe.pushFix(*fix, e.arrival);
     else if (auto* twist = std::get_if<TwistMeasurement>(&e.input)) pipe.pushTwist(source_of[e.topic], *twist, e.arrival);
     else pipe.pushPose(source_of[e.topic], std::get<PoseMeasurement>(e.input), e.arrival);

@@ -307,7 +307,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<std::shared_ptr<ndt::TargetCache>> site_targets;
   for (std::size_t s = 0; s < config.sites.size(); ++s) site_targets.push_back(std::make_shared<ndt::TargetCache>(32));
   // And the roof LiDAR's ray hits at the cruise speed (every drive but the speed sweep's): cast once per
-  // site, about 180 MB each, instead of once per drive.
+  // site (169 MB each in a quick run), instead of once per drive.
   // The RSUs' frames likewise, where the RSU stands at its scenario's height (every drive but the sweeps').
   std::vector<std::shared_ptr<sim::SweepCache>> site_sweeps, site_frames;
   for (std::size_t s = 0; s < config.sites.size(); ++s) {

@@ -93,10 +93,15 @@ bool neighboursNear(const sim::Scenario& scenario, const sim::Route& route, cons
   return false;
 }
 
-std::vector<Eigen::Vector3f> frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, std::mt19937_64& rng) {
+std::vector<Eigen::Vector3f> positionsOf(const std::vector<sim::LidarPoint>& points) {
   std::vector<Eigen::Vector3f> frame;
-  for (const auto& p : sim::scanSweep(spec, world, [&](double) { return pose; }, rng)) frame.push_back(p.position);
+  frame.reserve(points.size());
+  for (const auto& p : points) frame.push_back(p.position);
   return frame;
+}
+
+std::vector<Eigen::Vector3f> frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, std::mt19937_64& rng) {
+  return positionsOf(sim::scanSweep(spec, world, [&](double) { return pose; }, rng));
 }
 
 std::uint64_t raysPerSweep(const sim::LidarSpec& spec) {
@@ -341,7 +346,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         const std::uint64_t key = (static_cast<std::uint64_t>(&r - rsus.data()) << 32) | summary.scans;
         const auto hits = options.rsu_frames->get(key, sim::sweepFingerprint(r.lidar, still, ego, 3),
                                                   [&] { return sim::castSweep(r.lidar, with_vehicle.caster(), still); });
-        for (const auto& p : sim::sweepPoints(r.lidar, *hits, rng)) frame.push_back(p.position);
+        frame = positionsOf(sim::sweepPoints(r.lidar, *hits, rng));
       } else {
         frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);
       }

@@ -4,7 +4,7 @@
 // its per-scan covariance estimation is timed). Prints medians (15 and 51 runs) and the distance of
 // each result from the reference GT1. See CMakeLists.txt for how to build it.
 //
-//   build-peers/peer_bench data
+//   build-peers/peer_bench
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pclomp/ndt_omp.h>
@@ -15,7 +15,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <string>
 #include <vector>
@@ -23,16 +22,11 @@
 #include "coloc/ndt/aligner.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/preprocess.hpp"
+#include "real_data.hpp"
+#include "seeded_starts.hpp"
 
 using namespace coloc;
 using Clock = std::chrono::steady_clock;
-
-static Eigen::Matrix4d readMatrix(const std::string& path) {
-  std::ifstream in(path);
-  Eigen::Matrix4d m;
-  for (int i = 0; i < 16; ++i) in >> m(i / 4, i % 4);
-  return m;
-}
 
 static pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const ndt::PointCloud& c) {
   auto out = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
@@ -51,27 +45,19 @@ static Row measure(int runs, const Eigen::Matrix4d& gt, const std::function<Eige
     t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
   }
   std::sort(t.begin(), t.end());
-  const double cm = 100.0 * (r.topRightCorner<3, 1>() - gt.topRightCorner<3, 1>()).norm();
-  const double deg = Eigen::AngleAxisd(Eigen::Matrix3d(r.topLeftCorner<3, 3>() * gt.topLeftCorner<3, 3>().transpose())).angle() * 180 / M_PI;
-  return {t[t.size() / 2], cm, deg};
+  const auto [m, deg] = testing::poseDifference(r, gt);
+  return {t[t.size() / 2], 100.0 * m, deg};
 }
 
-int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: peer_bench DATA_DIR (coloc's data/ folder)\n");
-    return 2;
-  }
-  const std::string data = argv[1];
-  const ndt::PointCloud target = ndt::loadPcd(data + "/hdl32e_pair/target.pcd");
-  const ndt::PointCloud raw = ndt::loadPcd(data + "/hdl32e_pair/source.pcd");
+int main() {
+  const ndt::PointCloud target = ndt::loadPcd(testing::realData("hdl32e_pair/target.pcd"));
+  const ndt::PointCloud raw = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
   const ndt::PointCloud dense = ndt::voxelDownsample(raw, 0.1);
   ndt::PreprocessConfig pre;
   pre.voxel_size = 1.0;
   const ndt::PointCloud sparse = ndt::preprocessScan(raw, pre);
-  const Eigen::Matrix4d gt = readMatrix(data + "/hdl32e_pair/T_target_source.gt1.txt");
-  Eigen::Matrix4d offset = gt;
-  offset.topLeftCorner<3, 3>() = Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * gt.topLeftCorner<3, 3>();
-  offset.topRightCorner<3, 1>() += Eigen::Vector3d(0.4, -0.3, 0.0);
+  const Eigen::Matrix4d gt = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
+  const Eigen::Matrix4d offset = testing::offsetPose(gt, 2.0 * M_PI / 180.0, Eigen::Vector3d(0.4, -0.3, 0.0));
   const auto target_pcl = toPcl(target), dense_pcl = toPcl(dense), sparse_pcl = toPcl(sparse);
   std::printf("inputs: target %zu points, dense source %zu, Autoware-sized source %zu\n", target.size(), dense.size(), sparse.size());
   std::printf("%-28s %7s | %9s %7s %7s | %9s %7s %7s\n", "contender", "threads", "dense ms", "cm", "deg", "1k ms", "cm", "deg");

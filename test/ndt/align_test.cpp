@@ -3,7 +3,6 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
-#include <random>
 #include <tuple>
 #include <Eigen/Geometry>
 
@@ -12,6 +11,7 @@
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/preprocess.hpp"
 #include "real_data.hpp"
+#include "seeded_starts.hpp"
 
 namespace coloc::ndt {
 namespace {
@@ -19,6 +19,8 @@ namespace {
 using coloc::testing::poseDifference;
 using coloc::testing::readMatrix4;
 using coloc::testing::realData;
+using coloc::testing::offsetPose;
+using coloc::testing::seededStarts;
 
 class RealPair : public ::testing::Test {
  protected:
@@ -97,14 +99,6 @@ PointCloud autowareSizedScan() {
   return preprocessScan(loadPcd(realData("hdl32e_pair/source.pcd")), pre);
 }
 
-// `reference` turned by `yaw` about the vertical and moved by `offset`.
-Eigen::Matrix4d offsetPose(const Eigen::Matrix4d& reference, double yaw, const Eigen::Vector3d& offset) {
-  Eigen::Matrix4d guess = reference;
-  guess.topLeftCorner<3, 3>() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * reference.topLeftCorner<3, 3>();
-  guess.topRightCorner<3, 1>() += offset;
-  return guess;
-}
-
 TEST_F(RealPair, AutowareSizedInputConvergesFromHalfMetreAndTwoDegreesOff) {
   NdtConfig config;
   const NdtTarget target(*target_, config);
@@ -129,13 +123,8 @@ TEST_F(RealPair, FromTwentySeededStartsFarOffAlmostAllConvergeOnBothInputSizes) 
   const PointCloud sparse = autowareSizedScan();
   for (const PointCloud* scan : {static_cast<const PointCloud*>(source_), &sparse})
     for (const auto& [metres, degrees, needed] : {std::tuple<double, double, int>{1.0, 5.0, 19}, std::tuple<double, double, int>{2.0, 10.0, 15}}) {
-      std::mt19937 rng(20);
-      std::uniform_real_distribution<double> direction(-M_PI, M_PI);
-      std::bernoulli_distribution sign(0.5);
       int converged = 0;
-      for (int i = 0; i < 20; ++i) {
-        const double heading = direction(rng), yaw = (sign(rng) ? 1.0 : -1.0) * degrees * M_PI / 180.0;
-        const Eigen::Matrix4d guess = offsetPose(gt1_, yaw, metres * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0.0));
+      for (const Eigen::Matrix4d& guess : seededStarts(gt1_, metres, degrees)) {
         const auto [m, d] = poseDifference(align(target, *scan, guess, config).transform, gt1_);
         if (m <= 0.05 && d <= 0.5) ++converged;
       }
