@@ -1,5 +1,7 @@
 #include "coloc/replay/replay_cache.hpp"
 
+#include <algorithm>
+#include <map>
 #include <mutex>
 #include <sstream>
 
@@ -21,6 +23,23 @@ RecordedLog::RecordedLog(const std::string& path) {
   messages_.reserve(bag.messageCount());
   io::BagMessage message;
   while (bag.next(message)) messages_.push_back(std::move(message));
+  slots_ = std::make_unique<Slot[]>(messages_.size());
+}
+
+RecordedLog::RecordedLog(std::vector<io::TopicInfo> topics, std::vector<io::BagMessage> messages)
+    : topics_(std::move(topics)), messages_(std::move(messages)) {
+  std::map<std::string, std::size_t> topic_at;
+  for (std::size_t i = 0; i < topics_.size(); ++i) {
+    topic_at[topics_[i].name] = i;
+    topics_[i].message_count = 0;
+  }
+  for (const io::BagMessage& m : messages_) {
+    const auto t = topic_at.find(m.topic);
+    if (t == topic_at.end()) throw Error("recorded log: a message on topic " + m.topic + ", which the log does not list");
+    ++topics_[t->second].message_count;
+  }
+  std::stable_sort(messages_.begin(), messages_.end(), [](const io::BagMessage& a, const io::BagMessage& b) { return a.log_time < b.log_time; });
+  for (std::size_t i = 0; i < messages_.size(); ++i) messages_[i].index = i;
   slots_ = std::make_unique<Slot[]>(messages_.size());
 }
 
@@ -56,6 +75,16 @@ std::shared_ptr<const RecordedLog> ReplayCache::log(const std::string& path) {
   auto log = std::make_shared<const RecordedLog>(path);
   logs_.emplace_back(path, log);
   return log;
+}
+
+void ReplayCache::add(const std::string& name, std::shared_ptr<const RecordedLog> log) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto& [p, held] : logs_)
+    if (p == name) {
+      held = std::move(log);
+      return;
+    }
+  logs_.emplace_back(name, std::move(log));
 }
 
 ndt::TileMap ReplayCache::map(const std::string& path, double tile_size) {

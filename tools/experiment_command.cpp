@@ -18,7 +18,7 @@ void addExperimentCommand(CLI::App& app) {
                                  "VLP-32C, at sites A and B, over trials and a network grid; tables and figures");
   static std::string file, out_dir = "results/experiment";
   static int trials = 0, jobs = 0;
-  static bool quick = false, sweeps = false, no_network = false;
+  static bool quick = false, sweeps = false, no_network = false, recordings = false;
   cmd->add_option("FILE", file, "experiment YAML overriding the defaults (keys: see experiment_config.hpp or the README)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "results folder")->capture_default_str();
@@ -26,6 +26,7 @@ void addExperimentCommand(CLI::App& app) {
   cmd->add_flag("--quick", quick, "one trial of everything: a first look in a minute or two");
   cmd->add_flag("--sweeps", sweeps, "also sweep the RSU covariance, the RSU height and the speed");
   cmd->add_flag("--no-network", no_network, "skip the network grid (Tables II and III)");
+  cmd->add_flag("--recordings", recordings, "keep each drive's rosbag2 log under OUT/recordings/ (a few hundred MB per drive)");
   cmd->add_option("--jobs", jobs, "replays run side by side (default 2)");
   cmd->callback([app = &app] {
     ExperimentConfig config = file.empty() ? ExperimentConfig{} : loadExperimentConfig(file);
@@ -34,6 +35,7 @@ void addExperimentCommand(CLI::App& app) {
     if (jobs > 0) config.jobs = jobs;
     if (sweeps) config.sweeps = true;
     if (no_network) config.network = false;
+    if (recordings) config.recordings = true;
     std::filesystem::create_directories(out_dir);
     std::string command_line = "coloc experiment";
     for (const std::string& a : app->get_subcommand("experiment")->remaining()) command_line += " " + a;
@@ -42,6 +44,7 @@ void addExperimentCommand(CLI::App& app) {
     if (trials > 0) command_line += " --trials " + std::to_string(trials);
     if (sweeps) command_line += " --sweeps";
     if (no_network) command_line += " --no-network";
+    if (recordings) command_line += " --recordings";
     std::printf("coloc experiment: %zu site(s), %d trial(s), roadside LiDARs", config.sites.size(), config.trials);
     for (const std::string& l : config.lidars) std::printf(" %s", l.c_str());
     std::printf(config.network ? ", network grid %zux%zu" : ", no network grid", config.delays.size(), config.losses.size());

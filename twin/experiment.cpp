@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <exception>
 #include <filesystem>
 #include <future>
@@ -374,21 +375,39 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     if (drive.variant != "speed") r.options.roof_sweeps = site_sweeps[drive.site];
     if (drive.variant != "speed" && drive.variant != "RSU height") r.options.rsu_frames = site_frames[drive.site];
     r.options.ideal_comparison = drive.variant == kNoiseCalibrationDrive && !config.ideal_twin;
+    r.options.write_log = config.recordings;
+    r.options.keep_log = true;
     r.summary = recordTwin(r.scenario, r.options);
     r.seconds = since(t0);
     return r;
   };
-  // The first drive of a site surveys its map, which the site's later drives share; it has been
-  // recorded (and its map noted) before any of them starts.
-  std::future<Recorded> next = std::async(std::launch::async, record, 0);
+  // Up to two drives are simulated ahead of the one being replayed (the calibration drives, which have
+  // no replays of their own, and the sites' first drives then run side by side). The first drive of a
+  // site surveys its map, which the site's later drives share: none of them starts before that map is
+  // noted.
+  constexpr std::size_t kSimulatedAhead = 2;
+  std::deque<std::future<Recorded>> ahead;
+  std::size_t launched = 0;
+  auto launch = [&](std::size_t consumed) {
+    while (launched < drives.size() && launched < consumed + kSimulatedAhead) {
+      const std::size_t site = drives[launched].site;
+      bool surveying = false;  // an earlier drive of the site, not yet noted, is making its map
+      for (std::size_t e = 0; e < launched; ++e) surveying = surveying || (drives[e].site == site && maps[site].empty());
+      if (surveying) return;
+      ahead.push_back(std::async(std::launch::async, record, launched++));
+    }
+  };
+  launch(0);
   for (std::size_t d = 0; d < drives.size(); ++d) {
     const Drive& drive = drives[d];
-    Recorded recorded = next.get();
+    if (ahead.empty()) launch(d);
+    Recorded recorded = ahead.front().get();
+    ahead.pop_front();
     if (maps[drive.site].empty()) {
       maps[drive.site] = recorded.summary.map_dir;
       results.timing.survey += recorded.summary.map_seconds;
     }
-    if (d + 1 < drives.size()) next = std::async(std::launch::async, record, d + 1);
+    launch(d + 1);
     const sim::Scenario& scenario = recorded.scenario;
     const std::string& name = recorded.name;
     const std::string& variant = recorded.variant;
@@ -411,6 +430,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     // The drive's replays read its log once, and each NDT target of the site is built once (the same
     // results as apart).
     auto cache = std::make_shared<replay::ReplayCache>(site_targets[drive.site]);
+    cache->add(rec.out_dir + "/log", summary.log);
     auto makeJob = [&](const std::string& lidar, double delay, double loss, const std::string& job_variant,
                        std::optional<double> variance) {
       Job job;

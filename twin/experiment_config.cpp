@@ -67,6 +67,7 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     else if (key == "rsu_heights") c.rsu_heights = r.numberList(v, key, 0.5, 20.0);
     else if (key == "speeds") c.speeds = r.numberList(v, key, 1.0, 40.0);
     else if (key == "smoother") c.smoother = r.flag(v, key);
+    else if (key == "recordings") c.recordings = r.flag(v, key);
     else if (key == "twist_covariance") c.twist_covariance_estimated = r.choice(v, key, {"estimated", "message"}) == "estimated";
     else if (key == "ndt_covariance") c.ndt_covariance_estimated = r.choice(v, key, {"estimated", "published"}) == "estimated";
     else if (key == "calibration") c.calibration = r.flag(v, key);
@@ -84,7 +85,7 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
         r.fail(v, key, "expected [dx, dy, dyaw_deg] within 10 m and 30 deg");
     } else if (key == "calibration_clock_offset_ms") c.calibration_clock_offset_ms = r.inRange(v, key, -1000.0, 1000.0);
     else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, gate_recovery, bin_length, fuse_config, jobs, sweeps, "
-                                  "sweep_trials, rsu_heights, speeds, smoother, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance, ndt_covariance, error_sources, errors, rsu_calibration)");
+                                  "sweep_trials, rsu_heights, speeds, smoother, recordings, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance, ndt_covariance, error_sources, errors, rsu_calibration)");
   }
   if (c.delays.front() != 0.0 || c.losses.front() != 0.0)
     throwConfigError(source_name, -1, "delays/losses", "the first delay and the first loss must be 0: the ideal network is the reference");

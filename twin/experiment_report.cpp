@@ -643,8 +643,10 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << "## Files\n\n"
      << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`, `fix_error_by_distance.csv`, `attribution.csv`, `ndt_vs_fused.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
      << "- `error_along_road.csv`: minimum error per bin along the road, per site, trial and configuration (figures 4 and 5)\n"
-     << "- `recordings/SITE/trial_N/`: each drive as a rosbag2 log with its map and fuse configuration (`coloc fuse` replays it), the "
-        "RSU fixes, every RSU frame's outcome (`rsu_frames.csv`) and, for trial 0, what each perception step buys (`rsu_perception.svg`)\n";
+     << "- `recordings/SITE/trial_N/`: each drive's map and fuse configuration, the RSU fixes, every RSU frame's outcome "
+        "(`rsu_frames.csv`) and, for trial 0, what each perception step buys (`rsu_perception.svg`)"
+     << (c.recordings ? "; the drive as a rosbag2 log (`log/`, `coloc fuse` replays it)\n"
+                      : "; the drives were replayed from memory (`--recordings` keeps each as a rosbag2 log that `coloc fuse` replays)\n");
   writeFile(out_dir + "/README.md", md.str());
   return table1.str();
 }

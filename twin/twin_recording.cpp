@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include "coloc/core/error.hpp"
@@ -39,6 +40,38 @@ using Clock = std::chrono::steady_clock;
 constexpr Stamp kEpoch = 1'700'000'000'000'000'000LL;  // the twin's clock starts here: runs repeat exactly
 
 Stamp at(double t) { return kEpoch + fromSeconds(t); }
+
+// The drive's log: written as rosbag2, kept in memory, or both.
+class LogRecorder {
+ public:
+  LogRecorder(const std::string& directory, bool write, bool keep) : keep_(keep) {
+    if (write) bag_.emplace(io::BagWriter::create(directory));
+  }
+  void addTopic(const io::TopicInfo& topic) {
+    if (bag_) bag_->addTopic(topic);
+    if (keep_) topics_.push_back(topic);
+  }
+  void write(const std::string& topic, Stamp log_time, io::Bytes&& data) {
+    if (bag_) bag_->write(topic, log_time, data.data(), data.size());
+    if (!keep_) return;
+    io::BagMessage m;
+    m.topic = topic;
+    m.log_time = log_time;
+    m.data = std::move(data);
+    messages_.push_back(std::move(m));
+  }
+  std::shared_ptr<const replay::RecordedLog> close() {
+    if (bag_) bag_->close();
+    if (!keep_) return nullptr;
+    return std::make_shared<const replay::RecordedLog>(std::move(topics_), std::move(messages_));
+  }
+
+ private:
+  bool keep_;
+  std::optional<io::BagWriter> bag_;
+  std::vector<io::TopicInfo> topics_;
+  std::vector<io::BagMessage> messages_;
+};
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -263,7 +296,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   }
 
   // 4. The drive, recorded.
-  io::BagWriter bag = io::BagWriter::create(out_dir + "/log");
+  LogRecorder bag(out_dir + "/log", options.write_log, options.keep_log);
   bag.addTopic(topic("/points", "sensor_msgs/msg/PointCloud2"));
   bag.addTopic(topic("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
   bag.addTopic(topic("/ground_truth/odom", "nav_msgs/msg/Odometry"));
@@ -293,8 +326,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     gt.pose.pose.orientation = quaternionFromRollPitchYaw(0, 0, truth.yaw);
     gt.twist.linear = {truth.speed, 0, 0};
     gt.twist.angular = {0, 0, truth.yaw_rate};
-    const io::Bytes gt_bytes = io::encodeOdometry(gt);
-    bag.write("/ground_truth/odom", at(t), gt_bytes.data(), gt_bytes.size());
+    bag.write("/ground_truth/odom", at(t), io::encodeOdometry(gt));
     if (k % 2 == 0) {  // 50 Hz odometry, logged 2 ms after sensing
       const sim::OdometrySample o = sim::measureOdometry(truth, odometry_noise, rng);
       summary.odometry.emplace_back(o.speed, truth.speed, o.yaw_rate, truth.yaw_rate);
@@ -304,30 +336,35 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       tw.measurement.angular = {0, 0, o.yaw_rate};
       tw.measurement.covariance = Matrix6d::Zero();
       tw.measurement.covariance.diagonal() << 0.04, kInfinity, kInfinity, kInfinity, kInfinity, 0.01;
-      const io::Bytes b = io::encodeTwistWithCovarianceStamped(tw);
-      bag.write("/vehicle/twist", at(t) + 2'000'000, b.data(), b.size());
+      bag.write("/vehicle/twist", at(t) + 2'000'000, io::encodeTwistWithCovarianceStamped(tw));
     }
     if (k % 10 != 0) continue;
     // 10 Hz: a roof sweep, and each RSU's frame; the traffic where it is half-way through them.
     const double capture = t + 0.05;
     const sim::VehicleState seen = drive.at(capture);
-    scene.place(capture, nullptr);
     const auto c0 = Clock::now();
     // The LiDAR as mounted, which its recorded extrinsic (yaw 0) misses by errors.lidar_mount_yaw.
     const sim::SensorTrajectory roof_pose = [&](double dt) {
       return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height) * Eigen::AngleAxisd(errors.lidar_mount_yaw, Eigen::Vector3d::UnitZ());
     };
-    auto cast = [&] { return sim::castSweep(roof, scene.caster(), roof_pose); };
+    // The worlds are moved to the capture time only for a sweep cast afresh (placing rebuilds their BVH).
+    auto cast = [&] {
+      scene.place(capture, nullptr);
+      return sim::castSweep(roof, scene.caster(), roof_pose);
+    };
     const auto sweep = options.roof_sweeps
                            ? sim::sweepPoints(roof, *options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast), rng)
                            : sim::sweepPoints(roof, cast(), rng);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
-    const io::Bytes b = io::encodePointCloud2(toPointCloud2(sweep, at(t)));
-    bag.write("/points", at(t + 0.1) + 5'000'000, b.data(), b.size());  // the sweep ends, the driver publishes
+    bag.write("/points", at(t + 0.1) + 5'000'000, io::encodePointCloud2(toPointCloud2(sweep, at(t))));  // the sweep ends, the driver publishes
     ++summary.scans;
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
-    with_vehicle.place(capture, &seen);
+    bool placed = false;
+    const auto placeVehicle = [&] {
+      if (!placed) with_vehicle.place(capture, &seen);
+      placed = true;
+    };
     if (ideal_world) ideal_world->place(capture, &seen);
     bool any_in_range = false;
     for (const Rsu& r : rsus) any_in_range = any_in_range || (seen.position - r.info.position).norm() <= r.range;
@@ -345,9 +382,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         const double ego[3] = {seen.position.x(), seen.position.y(), seen.yaw};
         const std::uint64_t key = (static_cast<std::uint64_t>(&r - rsus.data()) << 32) | summary.scans;
         const auto hits = options.rsu_frames->get(key, sim::sweepFingerprint(r.lidar, still, ego, 3),
-                                                  [&] { return sim::castSweep(r.lidar, with_vehicle.caster(), still); });
+                                                  [&] {
+                                                    placeVehicle();
+                                                    return sim::castSweep(r.lidar, with_vehicle.caster(), still);
+                                                  });
         frame = positionsOf(sim::sweepPoints(r.lidar, *hits, rng));
       } else {
+        placeVehicle();
         frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);
       }
       summary.ray_casting_seconds += since(c1);
@@ -432,13 +473,12 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       fix.measurement.pose.position = {d.position.x(), d.position.y(), 0.0};
       fix.measurement.covariance = Matrix6d::Zero();
       fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;
-      const io::Bytes fb = io::encodePoseWithCovarianceStamped(fix);
-      bag.write(rsu_client::fixTopic(r.info.id), *delivered, fb.data(), fb.size());
+      bag.write(rsu_client::fixTopic(r.info.id), *delivered, io::encodePoseWithCovarianceStamped(fix));
       ++summary.fixes;
     }
   }
   if (options.progress) options.progress(1.0);
-  bag.close();
+  summary.log = bag.close();
   if (!fix_errors.empty()) {
     Plot plot;
     plot.title = "RSU fix error against distance from the RSU: " + scenario.name;

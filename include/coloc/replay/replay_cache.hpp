@@ -24,6 +24,10 @@ class RecordedLog {
  public:
   /// Throws coloc::Error as io::BagReader does for a log it cannot read.
   explicit RecordedLog(const std::string& path);
+  /// A log made in memory (a simulated drive): `messages` in the order they were written, put in the
+  /// order a rosbag2 reader gives them (by log time, then as written) and numbered; each topic's
+  /// message_count counted. Throws coloc::Error for a message on a topic not in `topics`.
+  RecordedLog(std::vector<io::TopicInfo> topics, std::vector<io::BagMessage> messages);
   ~RecordedLog();
 
   const std::vector<io::TopicInfo>& topics() const { return topics_; }
@@ -49,8 +53,11 @@ class ReplayCache {
   /// `targets`: NDT targets shared beyond this cache (drives on one site); none: a cache of its own.
   explicit ReplayCache(std::shared_ptr<ndt::TargetCache> targets = nullptr);
 
-  /// The log at `path`, read on its first request (a concurrent request waits for that read).
+  /// The log at `path`, read on its first request (a concurrent request waits for that read), or the
+  /// one added under that name.
   std::shared_ptr<const RecordedLog> log(const std::string& path);
+  /// Replays of `name` use `log` (one made in memory, never written) instead of reading a file.
+  void add(const std::string& name, std::shared_ptr<const RecordedLog> log);
   /// The map at `path` (ndt::TileMap::open), indexed on its first request.
   ndt::TileMap map(const std::string& path, double tile_size);
   const std::shared_ptr<ndt::TargetCache>& targets() const { return targets_; }

@@ -52,6 +52,9 @@ struct ExperimentConfig {
   double bin_length = 2.0;      ///< m of road per bin of the paper's metric (minimum error per bin)
   std::string fuse_config;      ///< optional fuse YAML applied to every replay (fusion, ndt, replay keys)
   int jobs = 2;                 ///< replays run side by side (each NDT on one thread)
+  /// Keep each drive's rosbag2 log under recordings/ (a few hundred MB per drive, about 18 GB for the
+  /// full run with the sweeps). Off, the drives are replayed from memory and only their CSVs are kept.
+  bool recordings = false;
   bool sweeps = false;          ///< also run the sweeps beyond the paper (covariance, RSU height, speed)
   int sweep_trials = 2;
   /// Sweep values besides the paper's (RSU 2 m high, 10 m/s), whose runs are the main experiment's.

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/replay/replay_cache.hpp"
 #include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
@@ -39,6 +40,11 @@ struct TwinRecordingOptions {
   /// The same for the RSUs' frames (the RSUs' true poses, the vehicle's path and the traffic are the
   /// same on every trial; their survey errors are not where the LiDARs are, only where the registry says).
   std::shared_ptr<sim::SweepCache> rsu_frames;
+  /// Write the log to out_dir/log (rosbag2). Off, with keep_log: the drive exists in memory only,
+  /// which spares the disk a few hundred MB per drive and the replays reading it back.
+  bool write_log = true;
+  /// Hand the log back in memory (TwinRecordingSummary::log), as a rosbag2 reader would give it.
+  bool keep_log = false;
 };
 
 /// One RSU frame within coverage: what the perception made of it.
@@ -67,6 +73,8 @@ struct TwinRecordingSummary {
   std::vector<Eigen::Vector4d> odometry;
   /// Per RSU id: every frame within its coverage.
   std::map<std::string, std::vector<RsuFrameRecord>> rsu_frames;
+  /// The log, when TwinRecordingOptions::keep_log (replay::ReplayCache::add replays it as if read).
+  std::shared_ptr<const replay::RecordedLog> log;
 };
 
 /// Throws coloc::Error if the output cannot be written.
