@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 
+#include "coloc/ndt/alignment_memo.hpp"
+
 namespace coloc::ndt {
 
 namespace {
@@ -15,8 +17,12 @@ Eigen::Matrix4d matrixOf(const Pose& pose) {
 
 }  // namespace
 
-NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets)
-    : config_((validate(config), config)), map_(std::move(map), config.ndt, config.map, std::move(targets)) {
+NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets,
+                             std::shared_ptr<AlignmentMemo> alignments)
+    : config_((validate(config), config)),
+      map_(std::move(map), config.ndt, config.map, std::move(targets)),
+      alignments_(std::move(alignments)),
+      fingerprint_(alignments_ ? configFingerprint(config_) : std::string()) {
   const Vector6d& p = config.lidar_pose;
   Pose lidar;
   lidar.position = p.head<3>();
@@ -24,34 +30,55 @@ NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std
   base_to_lidar_ = matrixOf(lidar);
 }
 
+NdtPoseSource::~NdtPoseSource() = default;
+
 ScanOutcome NdtPoseSource::process(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz) {
+  return process(scan, nullptr, stamp, predicted, vx, wz);
+}
+
+ScanOutcome NdtPoseSource::process(const std::shared_ptr<const PointCloud>& scan, Stamp stamp, const Pose& predicted, double vx, double wz) {
+  return process(*scan, alignments_ ? &scan : nullptr, stamp, predicted, vx, wz);
+}
+
+ScanOutcome NdtPoseSource::process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& predicted,
+                                   double vx, double wz) {
   ++counters_.scans;
-  ScanOutcome out;
+  // The map moves with the prediction whether or not the outcome is shared: its state is this source's.
   map_.update(predicted.position.head<2>());
   const auto target = map_.target();
   if (!target) {
     ++counters_.no_map;
+    ScanOutcome out;
     out.detail = "no map tile within reach of the predicted position";
     return out;
   }
+  ScanOutcome out;
+  if (shared) {
+    bool computed = false;
+    out = alignments_->answer(fingerprint_, {*shared, stamp, target, predicted, vx, wz}, [&] {
+      computed = true;
+      return match(scan, stamp, predicted, vx, wz, *target);
+    });
+    if (!computed) ++counters_.shared;
+  } else {
+    out = match(scan, stamp, predicted, vx, wz, *target);
+  }
+  count(out);
+  return out;
+}
+
+ScanOutcome NdtPoseSource::match(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz, const NdtTarget& target) const {
+  ScanOutcome out;
   const PointCloud cloud = preprocessScan(scan, config_.preprocess, vx, wz);
   out.points_used = cloud.size();
   if (cloud.empty()) {
-    ++counters_.empty_scan;
+    out.alignment.rejection = AlignRejection::kEmptySource;
     out.detail = "no point left after preprocessing";
     return out;
   }
   // NDT aligns the LiDAR frame; the filter wants the vehicle: map_T_base = map_T_lidar * lidar_T_base.
   const Eigen::Matrix4d guess = matrixOf(predicted) * base_to_lidar_;
-  out.alignment = align(*target, cloud, guess, config_.ndt);
-  counters_.align_ms_total += out.alignment.elapsed_ms;
-  switch (out.alignment.rejection) {
-    case AlignRejection::kNone: break;
-    case AlignRejection::kMaxIterations: ++counters_.max_iterations; break;
-    case AlignRejection::kOscillation: ++counters_.oscillation; break;
-    case AlignRejection::kLowScore: ++counters_.low_score; break;
-    case AlignRejection::kEmptySource: ++counters_.empty_scan; break;
-  }
+  out.alignment = align(target, cloud, guess, config_.ndt);
   if (!out.alignment.accepted()) {
     out.detail = std::string(toString(out.alignment.rejection)) + ": " + out.alignment.detail;
     return out;
@@ -62,8 +89,19 @@ ScanOutcome NdtPoseSource::process(const PointCloud& scan, Stamp stamp, const Po
   out.pose.pose.orientation = Eigen::Quaterniond(base.topLeftCorner<3, 3>()).normalized();
   out.pose.covariance = out.alignment.covariance;
   out.produced = true;
-  ++counters_.poses;
   return out;
+}
+
+void NdtPoseSource::count(const ScanOutcome& out) {
+  counters_.align_ms_total += out.alignment.elapsed_ms;
+  switch (out.alignment.rejection) {
+    case AlignRejection::kNone: break;
+    case AlignRejection::kMaxIterations: ++counters_.max_iterations; break;
+    case AlignRejection::kOscillation: ++counters_.oscillation; break;
+    case AlignRejection::kLowScore: ++counters_.low_score; break;
+    case AlignRejection::kEmptySource: ++counters_.empty_scan; break;
+  }
+  if (out.produced) ++counters_.poses;
 }
 
 }  // namespace coloc::ndt

@@ -9,6 +9,15 @@
 
 namespace coloc::ndt {
 
+namespace {
+
+double squaredRange(const Eigen::Vector3f& p) {
+  const double x = p.x(), y = p.y(), z = p.z();
+  return x * x + y * y + z * z;
+}
+
+}  // namespace
+
 PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range) {
   PointCloud out;
   const bool times = cloud.hasTimes();
@@ -16,7 +25,7 @@ PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range
   if (times) out.times.reserve(cloud.size());
   const double lo = min_range * min_range, hi = max_range * max_range;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const double r = cloud.points[i].cast<double>().squaredNorm();
+    const double r = squaredRange(cloud.points[i]);
     if (r < lo || r > hi) continue;
     out.points.push_back(cloud.points[i]);
     if (times) out.times.push_back(cloud.times[i]);
@@ -26,31 +35,103 @@ PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range
 
 namespace {
 
-// deskew() on a cloud of one's own, without the copy (preprocessScan's cropped cloud is its own).
+// The sensor's motion over a sweep, for moving a point into the frame at time 0: where the sensor was
+// at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0). The lasers of one firing
+// share its time, so the motion is recomputed only when the time changes.
+class Deskew {
+ public:
+  Deskew(double vx, double wz) : vx_(vx), wz_(wz) {}
+  Eigen::Vector3f operator()(const Eigen::Vector3f& p, float time) {
+    const double t = time;
+    if (!(t == last_t_)) {
+      last_t_ = t;
+      const double angle = wz_ * t;
+      if (std::abs(wz_) < 1e-9) {
+        dx_ = vx_ * t;
+        dy_ = 0.0;
+      } else {
+        dx_ = vx_ * std::sin(angle) / wz_;
+        dy_ = vx_ * (1.0 - std::cos(angle)) / wz_;
+      }
+      c_ = std::cos(angle);
+      s_ = std::sin(angle);
+    }
+    return Eigen::Vector3f(static_cast<float>(c_ * p.x() - s_ * p.y() + dx_), static_cast<float>(s_ * p.x() + c_ * p.y() + dy_), p.z());
+  }
+
+ private:
+  double vx_, wz_;
+  double last_t_ = std::nan(""), dx_ = 0.0, dy_ = 0.0, c_ = 1.0, s_ = 0.0;
+};
+
 void deskewInPlace(PointCloud& cloud, double vx, double wz) {
   if (!cloud.hasTimes()) return;
-  // Where the sensor was at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0). The
-  // lasers of one firing share its time, so the motion is recomputed only when the time changes.
-  double last_t = std::nan(""), dx = 0.0, dy = 0.0, c = 1.0, s = 0.0;
+  Deskew move(vx, wz);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const double t = cloud.times[i];
-    if (!(t == last_t)) {
-      last_t = t;
-      const double angle = wz * t;
-      if (std::abs(wz) < 1e-9) {
-        dx = vx * t;
-        dy = 0.0;
-      } else {
-        dx = vx * std::sin(angle) / wz;
-        dy = vx * (1.0 - std::cos(angle)) / wz;
-      }
-      c = std::cos(angle);
-      s = std::sin(angle);
-    }
-    const Eigen::Vector3f p = cloud.points[i];
-    cloud.points[i] = Eigen::Vector3f(static_cast<float>(c * p.x() - s * p.y() + dx), static_cast<float>(s * p.x() + c * p.y() + dy), p.z());
+    cloud.points[i] = move(cloud.points[i], cloud.times[i]);
     cloud.times[i] = 0.0f;
   }
+}
+
+// One point per occupied voxel, the centroid of the points `pointAt(i, point, time)` gives for
+// i = 0 .. count - 1 (false: no point), in order of first appearance.
+struct VoxelSum {
+  double x = 0.0, y = 0.0, z = 0.0, time = 0.0;
+  int count = 0;
+};
+
+// floor(v) as an integer voxel coordinate, false for a value that is not finite or whose voxel is
+// beyond 2e9 (integer arithmetic: floor() has no instruction on the baseline x86-64 this is built for).
+inline bool voxelCoordinate(double v, std::int32_t& out) {
+  if (!(std::abs(v) < 4e9)) return false;
+  std::int64_t k = static_cast<std::int64_t>(v);  // toward zero
+  if (static_cast<double>(k) > v) --k;
+  if (!(std::abs(static_cast<double>(k)) < 2e9)) return false;
+  out = static_cast<std::int32_t>(k);
+  return true;
+}
+
+// One point per occupied voxel, the centroid of the points `pointAt(i, point, time)` gives for
+// i = 0 .. count - 1 (false: no point), in order of first appearance.
+template <typename PointAt>
+PointCloud voxelCentroids(std::size_t count, bool times, double voxel_size, PointAt&& pointAt) {
+  VoxelIndex index;
+  std::vector<VoxelSum> sums;
+  const double inverse = 1.0 / voxel_size;
+  VoxelCoordinates last_key;
+  std::size_t last_at = 0;
+  bool have_last = false;
+  Eigen::Vector3f point;
+  float time = 0.0f;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!pointAt(i, point, time)) continue;
+    const double x = point.x(), y = point.y(), z = point.z();
+    // A point that is not finite, or too far out for integer voxel coordinates, has no voxel.
+    VoxelCoordinates key;
+    if (!voxelCoordinate(x * inverse, key.x) || !voxelCoordinate(y * inverse, key.y) || !voxelCoordinate(z * inverse, key.z)) continue;
+    // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
+    if (!(have_last && key == last_key)) {
+      const auto [at, inserted] = index.insert(key);
+      if (inserted) sums.emplace_back();
+      last_key = key;
+      last_at = at;
+      have_last = true;
+    }
+    VoxelSum& s = sums[last_at];
+    s.x += x;
+    s.y += y;
+    s.z += z;
+    if (times) s.time += time;
+    ++s.count;
+  }
+  PointCloud out;
+  out.points.reserve(sums.size());
+  if (times) out.times.reserve(sums.size());
+  for (const VoxelSum& s : sums) {
+    out.points.emplace_back(static_cast<float>(s.x / s.count), static_cast<float>(s.y / s.count), static_cast<float>(s.z / s.count));
+    if (times) out.times.push_back(static_cast<float>(s.time / s.count));
+  }
+  return out;
 }
 
 }  // namespace
@@ -63,44 +144,12 @@ PointCloud deskew(const PointCloud& cloud, double vx, double wz) {
 
 PointCloud voxelDownsample(const PointCloud& cloud, double voxel_size) {
   if (!(voxel_size > 0.0)) return cloud;
-  struct Sum {
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();
-    double time = 0.0;
-    int count = 0;
-  };
-  VoxelIndex index;
-  std::vector<Sum> sums;
-  const double inverse = 1.0 / voxel_size;
   const bool times = cloud.hasTimes();
-  VoxelCoordinates last_key;
-  std::size_t last_at = 0;
-  bool have_last = false;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3d p = cloud.points[i].cast<double>();
-    const Eigen::Array3d scaled = (p * inverse).array().floor();
-    // A point that is not finite, or too far out for integer voxel coordinates, has no voxel.
-    if (!(scaled.abs() < 2e9).all()) continue;
-    const VoxelCoordinates key{static_cast<std::int32_t>(scaled.x()), static_cast<std::int32_t>(scaled.y()), static_cast<std::int32_t>(scaled.z())};
-    // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
-    if (!(have_last && key == last_key)) {
-      const auto [at, inserted] = index.insert(key);
-      if (inserted) sums.emplace_back();
-      last_key = key;
-      last_at = at;
-      have_last = true;
-    }
-    Sum& s = sums[last_at];
-    s.point += p;
-    if (times) s.time += cloud.times[i];
-    ++s.count;
-  }
-  PointCloud out;
-  out.points.reserve(sums.size());
-  for (const Sum& s : sums) {
-    out.points.push_back((s.point / s.count).cast<float>());
-    if (times) out.times.push_back(static_cast<float>(s.time / s.count));
-  }
-  return out;
+  return voxelCentroids(cloud.size(), times, voxel_size, [&](std::size_t i, Eigen::Vector3f& p, float& t) {
+    p = cloud.points[i];
+    if (times) t = cloud.times[i];
+    return true;
+  });
 }
 
 PointCloud capPoints(const PointCloud& cloud, std::size_t max_points, std::uint32_t seed) {
@@ -125,9 +174,29 @@ PointCloud capPoints(const PointCloud& cloud, std::size_t max_points, std::uint3
 }
 
 PointCloud preprocessScan(const PointCloud& scan, const PreprocessConfig& config, double vx, double wz) {
-  PointCloud cloud = cropRange(scan, config.min_range, config.max_range);
-  if (config.deskew) deskewInPlace(cloud, vx, wz);
-  cloud = voxelDownsample(cloud, config.voxel_size);
+  if (!(config.voxel_size > 0.0)) {
+    PointCloud cloud = cropRange(scan, config.min_range, config.max_range);
+    if (config.deskew) deskewInPlace(cloud, vx, wz);
+    return capPoints(cloud, config.max_points, config.seed);
+  }
+  // Crop, deskew and downsample in one pass over the scan, without the cropped copy in between: the
+  // same points in the same order as the three steps one after the other, so the same bytes.
+  const bool times = scan.hasTimes();
+  const bool moving = config.deskew && times;
+  const double lo = config.min_range * config.min_range, hi = config.max_range * config.max_range;
+  Deskew move(vx, wz);
+  const PointCloud cloud = voxelCentroids(scan.size(), times, config.voxel_size, [&](std::size_t i, Eigen::Vector3f& p, float& t) {
+    const double r = squaredRange(scan.points[i]);
+    if (r < lo || r > hi) return false;
+    if (moving) {
+      p = move(scan.points[i], scan.times[i]);
+      t = 0.0f;
+    } else {
+      p = scan.points[i];
+      if (times) t = scan.times[i];
+    }
+    return true;
+  });
   return capPoints(cloud, config.max_points, config.seed);
 }
 

@@ -20,7 +20,7 @@ namespace coloc::pipeline {
 namespace {
 
 struct ScanInput {
-  ndt::PointCloud cloud;
+  std::shared_ptr<const ndt::PointCloud> cloud;  ///< shared, not copied, when the caller shares it
   Stamp stamp;
 };
 struct TwistInput {
@@ -85,7 +85,7 @@ class NdtThread {
     thread_.join();
   }
   /// False if a waiting scan was replaced.
-  bool submit(ndt::PointCloud cloud, Stamp stamp, const fusion::Estimate& guess) {
+  bool submit(std::shared_ptr<const ndt::PointCloud> cloud, Stamp stamp, const fusion::Estimate& guess) {
     std::lock_guard<std::mutex> lock(mutex_);
     const bool replaced = job_.has_value();
     job_ = Job{std::move(cloud), stamp, guess};
@@ -103,7 +103,7 @@ class NdtThread {
 
  private:
   struct Job {
-    ndt::PointCloud cloud;
+    std::shared_ptr<const ndt::PointCloud> cloud;
     Stamp stamp;
     fusion::Estimate guess;
   };
@@ -195,7 +195,7 @@ struct Pipeline::Impl {
       ndt::NdtPoseSourceConfig ndt_config = config.ndt.source;
       // Offline the target is built inline: the same log then gives the same bytes, whatever the machine's speed.
       if (!options.ndt_thread) ndt_config.map.background = false;
-      ndt = std::make_unique<ndt::NdtPoseSource>(std::move(*options.map), ndt_config, options.targets);
+      ndt = std::make_unique<ndt::NdtPoseSource>(std::move(*options.map), ndt_config, options.targets, options.alignments);
       ndt_id = addSource(kNdtSource, fusion::SourceKind::kPose);
       report.ndt_used = true;
       if (options.ndt_thread)
@@ -389,7 +389,14 @@ std::optional<fusion::SourceId> Pipeline::fixSource(const std::string& rsu_id) c
   return found->second;
 }
 
-void Pipeline::pushScan(ndt::PointCloud scan, Stamp stamp, Stamp arrival) { impl_->inbox.push(ScanInput{std::move(scan), stamp}, arrival); }
+void Pipeline::pushScan(ndt::PointCloud scan, Stamp stamp, Stamp arrival) {
+  pushScan(std::make_shared<const ndt::PointCloud>(std::move(scan)), stamp, arrival);
+}
+
+void Pipeline::pushScan(std::shared_ptr<const ndt::PointCloud> scan, Stamp stamp, Stamp arrival) {
+  if (!scan) scan = std::make_shared<const ndt::PointCloud>();  // nothing to match: counted as an empty scan
+  impl_->inbox.push(ScanInput{std::move(scan), stamp}, arrival);
+}
 void Pipeline::pushTwist(fusion::SourceId source, const TwistMeasurement& twist, Stamp arrival) {
   impl_->inbox.push(TwistInput{source, twist}, arrival);
 }

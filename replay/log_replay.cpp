@@ -202,6 +202,7 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
     po.map = options.cache ? options.cache->map(options.map, options.config.ndt.map_tile_size)
                            : ndt::TileMap::open(options.map, options.config.ndt.map_tile_size);
     if (options.cache) po.targets = options.cache->targets();
+    if (options.cache) po.alignments = options.cache->alignments();
   }
   pipeline::Pipeline pipe(options.config, std::move(po));
   std::vector<fusion::SourceId> source_of(result.topics.size(), -1);
@@ -236,7 +237,7 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
     const bool is_scan = std::holds_alternative<ndt::PointCloud>(e.input) || std::holds_alternative<SharedScan>(e.input);
     if (options.progress && (i % 256 == 0 || is_scan)) options.progress(0.5 + 0.5 * i / events.size());
     if (auto* scan = std::get_if<ndt::PointCloud>(&e.input)) pipe.pushScan(std::move(*scan), e.stamp, e.arrival);
-    else if (auto* shared = std::get_if<SharedScan>(&e.input)) pipe.pushScan(ndt::PointCloud(**shared), e.stamp, e.arrival);
+    else if (auto* shared = std::get_if<SharedScan>(&e.input)) pipe.pushScan(*shared, e.stamp, e.arrival);
     else if (auto* fix = std::get_if<rsu_client::RsuFix>(&e.input)) pipe.pushFix(*fix, e.arrival);
     else if (auto* twist = std::get_if<TwistMeasurement>(&e.input)) pipe.pushTwist(source_of[e.topic], *twist, e.arrival);
     else pipe.pushPose(source_of[e.topic], std::get<PoseMeasurement>(e.input), e.arrival);

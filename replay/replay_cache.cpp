@@ -65,7 +65,7 @@ RecordedLog::Scan RecordedLog::scan(std::size_t i, io::MessageKind kind) const {
 }
 
 ReplayCache::ReplayCache(std::shared_ptr<ndt::TargetCache> targets)
-    : targets_(targets ? std::move(targets) : std::make_shared<ndt::TargetCache>()) {}
+    : targets_(targets ? std::move(targets) : std::make_shared<ndt::TargetCache>()), alignments_(std::make_shared<ndt::AlignmentMemo>()) {}
 
 std::shared_ptr<const RecordedLog> ReplayCache::log(const std::string& path) {
   // Held while reading: replays of one drive start together and all want the same log.

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "coloc/ndt/preprocess.hpp"
 
@@ -79,6 +80,44 @@ TEST(Preprocess, DeskewWithoutTimesLeavesTheScanAlone) {
   PointCloud cloud;
   cloud.points = {{1, 2, 3}};
   EXPECT_EQ(deskew(cloud, 10.0, 1.0).points, cloud.points);
+}
+
+// preprocessScan crops, deskews and downsamples in one pass; it must give the bytes of the steps one
+// after the other, whatever the scan (times or not, points out of range or not finite) and settings.
+TEST(Preprocess, TheOnePassPreprocessingGivesTheBytesOfItsStepsOneAfterTheOther) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> coordinate(-70.0f, 70.0f);
+  PointCloud scan;
+  for (int firing = 0; firing < 400; ++firing)
+    for (int laser = 0; laser < 16; ++laser) {
+      scan.points.emplace_back(coordinate(rng), coordinate(rng), 0.1f * coordinate(rng));
+      scan.times.push_back(0.1f * firing / 400.0f);  // the lasers of a firing share its time
+    }
+  scan.points[17].x() = std::nanf("");
+  scan.points[18] = {0.2f, 0.1f, 0.0f};  // inside min_range
+  PointCloud without_times = scan;
+  without_times.times.clear();
+  for (const PointCloud* cloud : {&scan, &without_times})
+    for (bool deskew_on : {true, false})
+      for (double voxel : {3.0, 0.5, 0.0}) {
+        PreprocessConfig config;
+        config.deskew = deskew_on;
+        config.voxel_size = voxel;
+        config.max_points = 300;
+        PointCloud steps = cropRange(*cloud, config.min_range, config.max_range);
+        if (config.deskew) steps = deskew(steps, 8.0, 0.3);
+        steps = capPoints(voxelDownsample(steps, config.voxel_size), config.max_points, config.seed);
+        const PointCloud once = preprocessScan(*cloud, config, 8.0, 0.3);
+        const std::string what = std::string(cloud->hasTimes() ? "times" : "no times") + (deskew_on ? ", deskew" : "") + ", voxel " + std::to_string(voxel);
+        ASSERT_EQ(once.points.size(), steps.points.size()) << what;
+        ASSERT_EQ(once.times.size(), steps.times.size()) << what;
+        for (std::size_t i = 0; i < steps.size(); ++i) {
+          EXPECT_EQ(once.points[i], steps.points[i]) << what << ", point " << i;
+          if (steps.hasTimes()) {
+            EXPECT_EQ(once.times[i], steps.times[i]) << what << ", point " << i;
+          }
+        }
+      }
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ rsu_client::RsuFix fixAt(Stamp stamp, double x, double y) { return {stamp, "rsu_
 // A vehicle at 5 m/s along x from the origin: twists at 50 Hz, a starting pose, and a fix at `fix_stamp`
 // arriving `fix_delay` later. Returns the last estimate.
 fusion::Estimate driveWithFix(Duration fix_delay, std::vector<fusion::Estimate>* ticks = nullptr) {
-  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}, nullptr});
+  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}, nullptr, nullptr});
   const fusion::SourceId odom = pipe.addTwistSource("odom");
   if (ticks) pipe.onEstimate([&](const fusion::Estimate& e) { ticks->push_back(e); });
   pipe.pushInitialPose(planarPose(kStart, 0.0, 0.0, 0.0), kStart);
@@ -64,7 +64,7 @@ TEST(Pipeline, ALateFixGivesTheSameEstimateAsAnOnTimeOne) {
 
 TEST(Pipeline, ASettledEstimateIsTheFiltersViewOfAPosesStampOnceThatPoseIsIn) {
   // The fix 50 ms late: the tick's output at its stamp cannot know it, the settled estimate does.
-  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}, nullptr});
+  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}, nullptr, nullptr});
   const fusion::SourceId odom = pipe.addTwistSource("odom");
   std::vector<std::pair<std::string, fusion::Estimate>> settled;
   pipe.onPoseSettled([&](const std::string& source, const fusion::Estimate& e) { settled.emplace_back(source, e); });
@@ -83,7 +83,7 @@ TEST(Pipeline, ASettledEstimateIsTheFiltersViewOfAPosesStampOnceThatPoseIsIn) {
 }
 
 TEST(Pipeline, FixesPassTheRegistrysChecksBeforeReachingTheFilter) {
-  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}, nullptr});
+  Pipeline pipe(kConfig, PipelineOptions{std::nullopt, oneRsu(), false, {}, nullptr, nullptr});
   std::vector<std::string> rejections;
   pipe.onRejection([&](const std::string& line) { rejections.push_back(line); });
   pipe.pushInitialPose(planarPose(kStart, 10.0, 0.0, 0.0), kStart);

@@ -25,6 +25,7 @@ void validate(const NdtPoseSourceConfig& config);
 
 struct NdtPoseSourceCounters {
   std::uint64_t scans = 0;
+  std::uint64_t shared = 0;           ///< outcomes taken from an AlignmentMemo, not computed here
   std::uint64_t poses = 0;            ///< accepted results handed on
   std::uint64_t no_map = 0;           ///< no tile near the predicted position
   std::uint64_t empty_scan = 0;       ///< nothing left after preprocessing
@@ -42,21 +43,35 @@ struct ScanOutcome {
   std::string detail;    ///< why nothing was produced
 };
 
+class AlignmentMemo;
+
 class NdtPoseSource {
  public:
-  /// `targets`: a cache of NDT targets shared with other sources on the same map (see target_cache.hpp).
-  NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets = nullptr);
+  /// `targets`: a cache of NDT targets shared with other sources on the same map (see target_cache.hpp);
+  /// `alignments`: outcomes shared with other sources asked the same (alignment_memo.hpp).
+  NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets = nullptr,
+                std::shared_ptr<AlignmentMemo> alignments = nullptr);
+  ~NdtPoseSource();
 
   /// `scan` in the LiDAR frame, `predicted` the vehicle pose the filter predicts for `stamp`, `vx` and
   /// `wz` its twist (for deskewing). Never throws for bad scans: the outcome says what happened.
   ScanOutcome process(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
+  /// The same for a scan shared with other sources (replays of one log): with an AlignmentMemo, asked of it.
+  ScanOutcome process(const std::shared_ptr<const PointCloud>& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
 
   const NdtPoseSourceCounters& counters() const { return counters_; }
   const DynamicMap& map() const { return map_; }
 
  private:
+  /// `shared`: the scan as shared, to ask alignments_ about; null: computed here.
+  ScanOutcome process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& predicted, double vx, double wz);
+  ScanOutcome match(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz, const NdtTarget& target) const;
+  void count(const ScanOutcome& out);
+
   NdtPoseSourceConfig config_;
   DynamicMap map_;
+  std::shared_ptr<AlignmentMemo> alignments_;
+  std::string fingerprint_;  ///< of config_, for alignments_
   Eigen::Matrix4d base_to_lidar_;
   NdtPoseSourceCounters counters_;
 };

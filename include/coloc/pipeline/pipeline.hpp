@@ -39,6 +39,9 @@ struct PipelineOptions {
   std::function<Stamp()> clock;
   /// NDT targets shared with other pipelines on the same map (replays of one drive side by side).
   std::shared_ptr<ndt::TargetCache> targets;
+  /// NDT's outcomes shared with other pipelines asked the same (replays of one log that differ only in
+  /// their fixes): see ndt/alignment_memo.hpp. Used for scans pushed as shared pointers.
+  std::shared_ptr<ndt::AlignmentMemo> alignments;
 };
 
 /// What the pipeline has done so far: per-source filter counters, NDT, fixes, rejections.
@@ -84,6 +87,8 @@ class Pipeline {
   // Inputs, from any thread. `arrival` is when the input reached the vehicle, on the clock the
   // pipeline runs on (the system clock live, log time offline).
   void pushScan(ndt::PointCloud scan, Stamp stamp, Stamp arrival);
+  /// A scan shared with others (a log held in memory): not copied.
+  void pushScan(std::shared_ptr<const ndt::PointCloud> scan, Stamp stamp, Stamp arrival);
   void pushTwist(fusion::SourceId source, const TwistMeasurement& twist, Stamp arrival);
   void pushPose(fusion::SourceId source, const PoseMeasurement& pose, Stamp arrival);
   void pushFix(const rsu_client::RsuFix& fix, Stamp arrival);

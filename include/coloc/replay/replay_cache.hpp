@@ -1,8 +1,9 @@
 #pragma once
 // What replays of one log share when they run side by side with different configurations (the
 // experiment replays each simulated drive about twenty times): the log read once, its scans decoded
-// once, the map's tile index read once, and NDT targets built once per set of tiles. Everything shared
-// is immutable once made, so a replay with the cache gives the same bytes as one without.
+// once, the map's tile index read once, NDT targets built once per set of tiles, and NDT's outcome for a
+// scan computed once per question asked of it. Everything shared is immutable once made, so a replay
+// with the cache gives the same bytes as one without.
 //
 // Thread-safe. Memory: a log is held whole (its messages and decoded scans) while the cache lives.
 #include <memory>
@@ -13,6 +14,7 @@
 #include "coloc/core/time.hpp"
 #include "coloc/io/bag_message.hpp"
 #include "coloc/io/ros_messages.hpp"
+#include "coloc/ndt/alignment_memo.hpp"
 #include "coloc/ndt/point_cloud.hpp"
 #include "coloc/ndt/target_cache.hpp"
 #include "coloc/ndt/tile_map.hpp"
@@ -61,12 +63,16 @@ class ReplayCache {
   /// The map at `path` (ndt::TileMap::open), indexed on its first request.
   ndt::TileMap map(const std::string& path, double tile_size);
   const std::shared_ptr<ndt::TargetCache>& targets() const { return targets_; }
+  /// NDT's outcomes per scan, shared by the replays: those that differ only in their RSU fixes match
+  /// each scan before the first fix once (ndt/alignment_memo.hpp).
+  const std::shared_ptr<ndt::AlignmentMemo>& alignments() const { return alignments_; }
 
  private:
   std::mutex mutex_;
   std::vector<std::pair<std::string, std::shared_ptr<const RecordedLog>>> logs_;
   std::vector<std::pair<std::string, std::shared_ptr<const ndt::TileMap>>> maps_;
   std::shared_ptr<ndt::TargetCache> targets_;
+  std::shared_ptr<ndt::AlignmentMemo> alignments_;
 };
 
 }  // namespace coloc::replay

@@ -1,0 +1,133 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include "coloc/ndt/alignment_memo.hpp"
+#include "coloc/ndt/pcd_file.hpp"
+#include "coloc/ndt/target_cache.hpp"
+#include "real_data.hpp"
+
+namespace coloc::ndt {
+namespace {
+
+// The real HDL-32E pair: the target scan is the map, the source scan is what the vehicle sees.
+struct RealPair {
+  std::string map = testing::realData("hdl32e_pair/target.pcd");
+  std::shared_ptr<const PointCloud> scan = std::make_shared<const PointCloud>(loadPcd(testing::realData("hdl32e_pair/source.pcd")));
+  NdtPoseSourceConfig config;
+  Pose predicted;
+  std::shared_ptr<TargetCache> targets = std::make_shared<TargetCache>();  // the sources share targets, as replays do
+  RealPair() {
+    config.preprocess.voxel_size = 1.0;
+    config.ndt.threads = 1;
+    config.map.background = false;
+    const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
+    predicted.position = gt1.topRightCorner<3, 1>() + Eigen::Vector3d(0.3, -0.2, 0.0);
+    predicted.orientation = Eigen::Quaterniond(gt1.topLeftCorner<3, 3>()).normalized();
+  }
+  NdtPoseSource source(std::shared_ptr<AlignmentMemo> memo, const NdtPoseSourceConfig* other = nullptr, bool own_target = false) const {
+    return NdtPoseSource(TileMap::open(map), other ? *other : config, own_target ? nullptr : targets, std::move(memo));
+  }
+};
+
+void expectSameOutcome(const ScanOutcome& a, const ScanOutcome& b) {
+  EXPECT_EQ(a.produced, b.produced);
+  EXPECT_EQ(a.alignment.transform, b.alignment.transform);
+  EXPECT_EQ(a.alignment.covariance, b.alignment.covariance);
+  EXPECT_EQ(a.alignment.iterations, b.alignment.iterations);
+  EXPECT_EQ(a.alignment.nvtl, b.alignment.nvtl);
+  EXPECT_EQ(a.pose.pose.position, b.pose.pose.position);
+  EXPECT_EQ(a.points_used, b.points_used);
+  EXPECT_EQ(a.detail, b.detail);
+}
+
+TEST(AlignmentMemo, SourcesAskingTheSameQuestionShareOneComputationAndGetItsBytes) {
+  const RealPair pair;
+  auto memo = std::make_shared<AlignmentMemo>();
+  NdtPoseSource first = pair.source(memo), second = pair.source(memo), alone = pair.source(nullptr);
+  const ScanOutcome computed = first.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
+  const ScanOutcome shared = second.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
+  const ScanOutcome own = alone.process(*pair.scan, 100, pair.predicted, 5.0, 0.1);
+  ASSERT_TRUE(own.produced) << own.detail;
+  expectSameOutcome(computed, own);
+  expectSameOutcome(shared, own);
+  EXPECT_EQ(memo->stats().asked, 2u);
+  EXPECT_EQ(memo->stats().computed, 1u);
+  EXPECT_EQ(first.counters().shared, 0u);
+  EXPECT_EQ(second.counters().shared, 1u);
+  // The shared outcome counts as the source's own in every other counter.
+  EXPECT_EQ(second.counters().scans, alone.counters().scans);
+  EXPECT_EQ(second.counters().poses, alone.counters().poses);
+}
+
+TEST(AlignmentMemo, AnyDifferenceInTheQuestionIsComputedAfresh) {
+  const RealPair pair;
+  auto memo = std::make_shared<AlignmentMemo>();
+  NdtPoseSource source = pair.source(memo);
+  source.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
+  Pose nudged = pair.predicted;
+  nudged.position.x() = std::nextafter(nudged.position.x(), 1e9);  // one bit
+  source.process(pair.scan, 100, nudged, 5.0, 0.1);
+  source.process(pair.scan, 100, pair.predicted, std::nextafter(5.0, 6.0), 0.1);  // the twist deskews
+  source.process(pair.scan, 101, pair.predicted, 5.0, 0.1);                       // the stamp is in the pose
+  const auto copy = std::make_shared<const PointCloud>(*pair.scan);  // equal, but another scan
+  source.process(copy, 100, pair.predicted, 5.0, 0.1);
+  EXPECT_EQ(memo->stats().computed, 5u);
+  NdtPoseSourceConfig other = pair.config;
+  other.ndt.nvtl_threshold = 2.0;  // the same target, another configuration
+  NdtPoseSource differently = pair.source(memo, &other);
+  differently.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
+  EXPECT_EQ(memo->stats().computed, 6u);
+  EXPECT_EQ(differently.counters().shared, 0u);
+  NdtPoseSource apart = pair.source(memo, nullptr, true);  // an equal target, but its own
+  apart.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
+  EXPECT_EQ(memo->stats().computed, 7u);
+}
+
+TEST(AlignmentMemo, AQuestionAskedTwiceAtOnceIsComputedOnce) {
+  const RealPair pair;
+  auto memo = std::make_shared<AlignmentMemo>();
+  NdtPoseSource a = pair.source(memo), b = pair.source(memo);
+  ScanOutcome from_a, from_b;
+  std::thread ta([&] { from_a = a.process(pair.scan, 100, pair.predicted, 5.0, 0.1); });
+  std::thread tb([&] { from_b = b.process(pair.scan, 100, pair.predicted, 5.0, 0.1); });
+  ta.join();
+  tb.join();
+  expectSameOutcome(from_a, from_b);
+  EXPECT_EQ(memo->stats().computed, 1u);
+  EXPECT_EQ(a.counters().shared + b.counters().shared, 1u);
+}
+
+TEST(AlignmentMemo, AFailedComputationReachesItsCallerAndIsNotKept) {
+  const RealPair pair;
+  AlignmentMemo memo;
+  const std::string config = configFingerprint(pair.config);
+  const AlignmentMemo::Question q{pair.scan, 100, nullptr, pair.predicted, 5.0, 0.1};
+  EXPECT_THROW(memo.answer(config, q, []() -> ScanOutcome { throw std::runtime_error("out of memory"); }), std::runtime_error);
+  ScanOutcome made;
+  made.detail = "computed again";
+  EXPECT_EQ(memo.answer(config, q, [&] { return made; }).detail, "computed again");
+  EXPECT_EQ(memo.stats().computed, 2u);
+}
+
+TEST(AlignmentMemo, ConfigurationsDifferingInAnySettingHaveDifferentFingerprints) {
+  const NdtPoseSourceConfig base;
+  std::vector<NdtPoseSourceConfig> changed(10, base);
+  changed[0].ndt.resolution = 1.0;
+  changed[1].ndt.threads = 3;
+  changed[2].ndt.fixed_covariance[5] = 1e-3;
+  changed[3].ndt.covariance = CovarianceMode::kLaplace;
+  changed[4].preprocess.deskew = false;
+  changed[5].preprocess.max_points = 10;
+  changed[6].preprocess.seed = 2;
+  changed[7].map.update_distance = 5.0;
+  changed[8].lidar_pose[5] = 0.01;
+  changed[9].ndt.max_oscillations = 3;
+  for (std::size_t i = 0; i < changed.size(); ++i) EXPECT_NE(configFingerprint(changed[i]), configFingerprint(base)) << "change " << i;
+  EXPECT_EQ(configFingerprint(NdtPoseSourceConfig{}), configFingerprint(base));
+}
+
+}  // namespace
+}  // namespace coloc::ndt
