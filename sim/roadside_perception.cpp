@@ -147,8 +147,10 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   const double footprint_range = (lidar_local - nearest_local).norm();
   constexpr double kOccluderClearance = 0.3;  // m nearer than the footprint: the footprint's own error and noise
   const auto inSector = [&](const Eigen::Vector2d& xy) {
+    // Range first: most of a frame lies beyond the vehicle, and needs no bearing.
+    if (!((xy - lidar).norm() < footprint_range - kOccluderClearance)) return false;
     const double b = wrapAngle(std::atan2(xy.y() - lidar.y(), xy.x() - lidar.x()) - bearing0);
-    return b >= bearing_lo && b <= bearing_hi && (xy - lidar).norm() < footprint_range - kOccluderClearance;
+    return b >= bearing_lo && b <= bearing_hi;
   };
   // 1. Foreground: near the expected position and away from the reference frame. Points farther from
   //    the reference position are background without a tree query (the paper's restriction), except

@@ -307,14 +307,21 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   // A site's drives follow one route on one map: they share its NDT targets (about 15 along a drive).
   std::vector<std::shared_ptr<ndt::TargetCache>> site_targets;
   for (std::size_t s = 0; s < config.sites.size(); ++s) site_targets.push_back(std::make_shared<ndt::TargetCache>(32));
-  // And the roof LiDAR's ray hits at the cruise speed (every drive but the speed sweep's): cast once per
-  // site (169 MB each in a quick run), instead of once per drive.
-  // The RSUs' frames likewise, where the RSU stands at its scenario's height (every drive but the sweeps').
-  std::vector<std::shared_ptr<sim::SweepCache>> site_sweeps, site_frames;
-  for (std::size_t s = 0; s < config.sites.size(); ++s) {
-    site_sweeps.push_back(std::make_shared<sim::SweepCache>());
-    site_frames.push_back(std::make_shared<sim::SweepCache>());
-  }
+  // And the roof LiDAR's ray hits, cast once per site and speed (169 MB at the cruise speed in a quick
+  // run) instead of once per drive; the RSUs' frames likewise, once per site, speed and RSU height.
+  // A cache is let go after the last drive that uses it has been simulated.
+  auto roofKey = [&](const Drive& d) { return std::to_string(d.site) + (d.variant == "speed" ? " speed " + std::to_string(d.speed) : ""); };
+  auto framesKey = [&](const Drive& d) { return roofKey(d) + (d.variant == "RSU height" ? " height " + std::to_string(d.rsu_height) : ""); };
+  std::mutex sweeps_mutex;
+  std::map<std::string, std::shared_ptr<sim::SweepCache>> sweep_caches;
+  std::map<std::string, std::size_t> last_use;  // cache key -> the last drive that uses it
+  for (std::size_t d = 0; d < drives.size(); ++d) last_use["roof " + roofKey(drives[d])] = last_use["frames " + framesKey(drives[d])] = d;
+  auto sweepCache = [&](const std::string& key) {
+    std::lock_guard<std::mutex> lock(sweeps_mutex);
+    auto& cache = sweep_caches[key];
+    if (!cache) cache = std::make_shared<sim::SweepCache>();
+    return cache;
+  };
   for (const std::string& site : config.sites) {
     scenarios.push_back(siteScenario(site, config));
     results.sites.push_back(siteInfo(scenarios.back()));
@@ -372,8 +379,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     fs::remove_all(r.options.out_dir);
     r.options.map_dir = maps[drive.site];
     r.options.perception_ablation = drive.trial == 0 && drive.variant.empty();
-    if (drive.variant != "speed") r.options.roof_sweeps = site_sweeps[drive.site];
-    if (drive.variant != "speed" && drive.variant != "RSU height") r.options.rsu_frames = site_frames[drive.site];
+    r.options.roof_sweeps = sweepCache("roof " + roofKey(drive));
+    r.options.rsu_frames = sweepCache("frames " + framesKey(drive));
     r.options.ideal_comparison = drive.variant == kNoiseCalibrationDrive && !config.ideal_twin;
     r.options.write_log = config.recordings;
     r.options.keep_log = true;
@@ -406,6 +413,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     if (maps[drive.site].empty()) {
       maps[drive.site] = recorded.summary.map_dir;
       results.timing.survey += recorded.summary.map_seconds;
+    }
+    {
+      std::lock_guard<std::mutex> lock(sweeps_mutex);
+      for (const auto& [key, last] : last_use)
+        if (last == d) sweep_caches.erase(key);
     }
     launch(d + 1);
     const sim::Scenario& scenario = recorded.scenario;
