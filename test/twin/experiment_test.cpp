@@ -36,6 +36,7 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_FALSE(c.ndt_covariance_estimated);
   EXPECT_FALSE(c.twist_covariance_estimated);
   EXPECT_TRUE(c.errors.empty());
+  EXPECT_FALSE(c.recordings);  // the drives are replayed from memory unless asked
   EXPECT_EQ(quickExperiment(c).trials, 1);
 }
 
@@ -59,6 +60,8 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_NE(errorOf("errors: {smog: 1}\n").find("errors.smog: unknown key"), std::string::npos);
   EXPECT_NE(errorOf("ndt_covariance: laplace\n").find("ndt_covariance: expected one of estimated, published"), std::string::npos);
   EXPECT_NE(errorOf("rsu_calibration: yes\n").find("rsu_calibration: expected one of noise_drive, none"), std::string::npos);
+  EXPECT_TRUE(parseExperimentConfig("recordings: true\n", "exp.yaml").recordings);
+  EXPECT_NE(errorOf("recordings: often\n").find("exp.yaml:1: recordings"), std::string::npos) << errorOf("recordings: often\n");
 }
 
 TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideIt) {
