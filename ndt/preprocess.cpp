@@ -73,8 +73,6 @@ void deskewInPlace(PointCloud& cloud, double vx, double wz) {
   }
 }
 
-// One point per occupied voxel, the centroid of the points `pointAt(i, point, time)` gives for
-// i = 0 .. count - 1 (false: no point), in order of first appearance.
 struct VoxelSum {
   double x = 0.0, y = 0.0, z = 0.0, time = 0.0;
   int count = 0;
@@ -93,9 +91,56 @@ inline bool voxelCoordinate(double v, std::int32_t& out) {
 
 // One point per occupied voxel, the centroid of the points `pointAt(i, point, time)` gives for
 // i = 0 .. count - 1 (false: no point), in order of first appearance.
+// Voxel -> its sum, by direct lookup for the voxels within kReach of the sensor's (a scan's, at the
+// voxel sizes NDT downsamples with), by hash for the rest. The table is the thread's, kept between
+// scans; only the cells a scan used are cleared after it.
+class VoxelSlots {
+ public:
+  static constexpr int kReach = 32;
+  static constexpr int kSide = 2 * kReach;
+  VoxelSlots() : cells_(static_cast<std::size_t>(kSide) * kSide * kSide, 0u) {}
+  ~VoxelSlots() = default;
+  /// Sum index of `key`, new ones numbered from `next`; `inserted` says whether it was new.
+  std::size_t find(const VoxelCoordinates& key, std::size_t next, bool& inserted) {
+    const std::uint32_t ux = static_cast<std::uint32_t>(key.x + kReach), uy = static_cast<std::uint32_t>(key.y + kReach),
+                        uz = static_cast<std::uint32_t>(key.z + kReach);
+    if ((ux | uy | uz) < static_cast<std::uint32_t>(kSide)) {
+      const std::size_t cell = ux + kSide * (uy + static_cast<std::size_t>(kSide) * uz);
+      std::uint32_t& slot = cells_[cell];
+      inserted = slot == 0;
+      if (inserted) {
+        slot = static_cast<std::uint32_t>(next + 1);
+        used_.push_back(static_cast<std::uint32_t>(cell));
+      }
+      return slot - 1;
+    }
+    const auto [at, fresh] = far_.insert(key);
+    inserted = fresh;
+    if (fresh) far_sums_.push_back(next);
+    return far_sums_[at];
+  }
+  /// Forgets this scan's voxels.
+  void clear() {
+    for (std::uint32_t cell : used_) cells_[cell] = 0;
+    used_.clear();
+    far_ = VoxelIndex();
+    far_sums_.clear();
+  }
+
+ private:
+  std::vector<std::uint32_t> cells_;  ///< sum index + 1, 0 = none
+  std::vector<std::uint32_t> used_;
+  VoxelIndex far_;
+  std::vector<std::size_t> far_sums_;
+};
+
 template <typename PointAt>
 PointCloud voxelCentroids(std::size_t count, bool times, double voxel_size, PointAt&& pointAt) {
-  VoxelIndex index;
+  thread_local VoxelSlots slots;
+  struct Clear {
+    VoxelSlots& s;
+    ~Clear() { s.clear(); }
+  } clear_after{slots};
   std::vector<VoxelSum> sums;
   const double inverse = 1.0 / voxel_size;
   VoxelCoordinates last_key;
@@ -111,7 +156,8 @@ PointCloud voxelCentroids(std::size_t count, bool times, double voxel_size, Poin
     if (!voxelCoordinate(x * inverse, key.x) || !voxelCoordinate(y * inverse, key.y) || !voxelCoordinate(z * inverse, key.z)) continue;
     // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
     if (!(have_last && key == last_key)) {
-      const auto [at, inserted] = index.insert(key);
+      bool inserted = false;
+      const std::size_t at = slots.find(key, sums.size(), inserted);
       if (inserted) sums.emplace_back();
       last_key = key;
       last_at = at;

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <tuple>
 #include <random>
 
 #include "coloc/ndt/preprocess.hpp"
@@ -118,6 +121,41 @@ TEST(Preprocess, TheOnePassPreprocessingGivesTheBytesOfItsStepsOneAfterTheOther)
           }
         }
       }
+}
+
+// The downsampling looks voxels up directly near the sensor and by hash beyond; either way each voxel
+// is its points' centroid, in order of first appearance, as a plain map from voxel to sum gives it.
+TEST(Preprocess, VoxelDownsampleIsThePlainCentroidPerVoxelNearTheSensorAndFarFromIt) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> near(-100.0f, 100.0f), far(-5000.0f, 5000.0f);
+  PointCloud cloud;
+  for (int i = 0; i < 20000; ++i) {
+    const bool out = i % 7 == 0;
+    cloud.points.emplace_back(out ? far(rng) : near(rng), out ? far(rng) : near(rng), 0.1f * near(rng));
+    cloud.times.push_back(0.01f * (i % 10));
+  }
+  for (float edge : {-96.0f, -95.9f, 93.0f, 96.0f, -99.1f, 98.9f}) cloud.points.emplace_back(edge, -edge, edge), cloud.times.push_back(0.0f);
+  for (int repeat = 0; repeat < 2; ++repeat) {  // the second time on a table the first left behind
+    const PointCloud out = voxelDownsample(cloud, 3.0);
+    std::map<std::tuple<long, long, long>, std::size_t> order;
+    std::vector<std::array<double, 5>> sums;  // x, y, z, time, count
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const Eigen::Vector3d p = cloud.points[i].cast<double>();
+      const auto key = std::make_tuple(static_cast<long>(std::floor(p.x() / 3.0)), static_cast<long>(std::floor(p.y() / 3.0)),
+                                       static_cast<long>(std::floor(p.z() / 3.0)));
+      const auto [it, fresh] = order.emplace(key, sums.size());
+      if (fresh) sums.push_back({0, 0, 0, 0, 0});
+      auto& s = sums[it->second];
+      s[0] += p.x(), s[1] += p.y(), s[2] += p.z(), s[3] += cloud.times[i], s[4] += 1;
+    }
+    ASSERT_EQ(out.size(), sums.size());
+    for (std::size_t v = 0; v < sums.size(); ++v) {
+      const auto& s = sums[v];
+      EXPECT_EQ(out.points[v], Eigen::Vector3f(static_cast<float>(s[0] / s[4]), static_cast<float>(s[1] / s[4]), static_cast<float>(s[2] / s[4])))
+          << "voxel " << v;
+      EXPECT_EQ(out.times[v], static_cast<float>(s[3] / s[4])) << "voxel " << v;
+    }
+  }
 }
 
 }  // namespace
