@@ -50,11 +50,17 @@ namespace {
 
 // Each ray's direction in the sensor frame, firing-major, for a spec's angles: the same every sweep, so
 // computed once per spec (the trigonometry was a third of a sweep's cost outside the ray casting).
-std::shared_ptr<const std::vector<Eigen::Vector3d>> localDirections(const LidarSpec& spec, int firings) {
+// In double for casting, and rounded to float for placing the points (as each point used to round it).
+struct Directions {
+  std::vector<Eigen::Vector3d> exact;
+  std::vector<Eigen::Vector3f> rounded;
+};
+
+std::shared_ptr<const Directions> localDirections(const LidarSpec& spec, int firings) {
   struct Entry {
     std::vector<double> vertical, offsets;
     double step;
-    std::shared_ptr<const std::vector<Eigen::Vector3d>> directions;
+    std::shared_ptr<const Directions> directions;
   };
   static std::mutex mutex;
   static std::vector<Entry> cache;
@@ -62,15 +68,17 @@ std::shared_ptr<const std::vector<Eigen::Vector3d>> localDirections(const LidarS
   for (const Entry& e : cache)
     if (e.vertical == spec.vertical_deg && e.offsets == spec.azimuth_offset_deg && e.step == spec.azimuth_step_deg) return e.directions;
   const int lasers = static_cast<int>(spec.vertical_deg.size());
-  auto directions = std::make_shared<std::vector<Eigen::Vector3d>>();
-  directions->reserve(static_cast<std::size_t>(firings * lasers));
+  auto directions = std::make_shared<Directions>();
+  directions->exact.reserve(static_cast<std::size_t>(firings * lasers));
   for (int f = 0; f < firings; ++f) {
     const double azimuth = spec.azimuth_step_deg * f;
     for (int l = 0; l < lasers; ++l) {
       const double a = (azimuth + spec.azimuth_offset_deg[l]) * M_PI / 180.0, e = spec.vertical_deg[l] * M_PI / 180.0;
-      directions->emplace_back(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+      directions->exact.emplace_back(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
     }
   }
+  directions->rounded.reserve(directions->exact.size());
+  for (const Eigen::Vector3d& d : directions->exact) directions->rounded.push_back(d.cast<float>());
   if (cache.size() >= 8) cache.erase(cache.begin());  // a twin uses two or three specs
   cache.push_back({spec.vertical_deg, spec.azimuth_offset_deg, spec.azimuth_step_deg, directions});
   return directions;
@@ -82,8 +90,8 @@ std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, con
   const int lasers = static_cast<int>(spec.vertical_deg.size());
   const int firings = firingsPerSweep(spec);
   const double sweep = 1.0 / spec.rotation_hz;
-  const std::shared_ptr<const std::vector<Eigen::Vector3d>> table = localDirections(spec, firings);
-  const std::vector<Eigen::Vector3d>& local = *table;
+  const std::shared_ptr<const Directions> table = localDirections(spec, firings);
+  const std::vector<Eigen::Vector3d>& local = table->exact;
   // Reused between sweeps of a thread: fresh buffers of this size cost page faults every sweep.
   thread_local std::vector<Eigen::Vector3f> origins, directions;
   const std::size_t rays = static_cast<std::size_t>(firings * lasers);
@@ -110,8 +118,8 @@ std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<Ray
   if (hits.size() != static_cast<std::size_t>(firings * lasers))
     throw Error("LiDAR sweep: " + std::to_string(hits.size()) + " ray hits for a " + spec.name + " sweep of " + std::to_string(firings * lasers) + " rays");
   const double sweep = 1.0 / spec.rotation_hz;
-  const std::shared_ptr<const std::vector<Eigen::Vector3d>> table = localDirections(spec, firings);
-  const std::vector<Eigen::Vector3d>& local = *table;
+  const std::shared_ptr<const Directions> table = localDirections(spec, firings);
+  const std::vector<Eigen::Vector3f>& local = table->rounded;
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const bool dropouts = spec.dropout > 0.0 || spec.dropout_at_max_range > 0.0;
@@ -129,7 +137,7 @@ std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<Ray
       if (dropouts && u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
       const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
       if (range < spec.min_range || range > spec.max_range) continue;
-      points.push_back({static_cast<float>(range) * local[i].cast<float>(), time, l, hits[i].mesh});
+      points.push_back({static_cast<float>(range) * local[i], time, l, hits[i].mesh});
     }
   }
   return points;
