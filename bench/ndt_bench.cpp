@@ -1,7 +1,9 @@
 // NDT cost, stock PCL against coloc's fast backend, measured side by side in one run:
 //  - the real HDL-32E pair, 0.1 m voxel source (~16k points), resolution 2.0, from identity;
 //  - Autoware-sized input (~1,000-1,500 points) from a 0.5 m / 2 deg initial offset;
-//  - building the target from the 487k-point airborne tile.
+//  - building the target from the 487k-point airborne tile;
+//  - preprocessing the raw scan as the pipeline does (range crop, 3 m voxels): pcl::VoxelGrid after a
+//    crop, as Autoware's downsampling does, against coloc's one pass.
 // Ends with a table of medians, ratios and the pose agreement of the two backends.
 //
 //   build/bench/ndt_bench
@@ -19,13 +21,16 @@
 #include "coloc/ndt/preprocess.hpp"
 #include "real_data.hpp"
 
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/point_types.h>
+
 namespace {
 
 using namespace coloc;
 using namespace coloc::ndt;
 
 struct Data {
-  PointCloud target, source_dense, source_autoware, als;
+  PointCloud target, raw, source_dense, source_autoware, als;
   Eigen::Matrix4d gt1, offset_guess;
 };
 
@@ -33,7 +38,8 @@ const Data& data() {
   static const Data d = [] {
     Data d;
     d.target = loadPcd(testing::realData("hdl32e_pair/target.pcd"));
-    const PointCloud raw = loadPcd(testing::realData("hdl32e_pair/source.pcd"));
+    d.raw = loadPcd(testing::realData("hdl32e_pair/source.pcd"));
+    const PointCloud& raw = d.raw;
     d.source_dense = voxelDownsample(raw, 0.1);
     PreprocessConfig pre;
     pre.voxel_size = 1.0;  // Autoware's 3 m leaves only ~240 points of this scan; 1 m gives ~1,000
@@ -84,6 +90,34 @@ void BM_BuildTargetAls(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(data().als.size());
 }
 
+// Argument 0: pcl::VoxelGrid after a range crop; 1: coloc's preprocessScan (crop, deskew, voxels in one pass).
+void BM_PreprocessScan(benchmark::State& state) {
+  PreprocessConfig pre;
+  pre.max_points = 0;  // the downsampling alone
+  std::size_t kept = 0;
+  if (state.range(0) == static_cast<int>(NdtBackend::kPcl)) {
+    for (auto _ : state) {
+      auto cropped = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+      cropped->reserve(data().raw.size());
+      const double lo = pre.min_range * pre.min_range, hi = pre.max_range * pre.max_range;
+      for (const Eigen::Vector3f& p : data().raw.points) {
+        const double r = p.cast<double>().squaredNorm();
+        if (r >= lo && r <= hi) cropped->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+      }
+      pcl::VoxelGrid<pcl::PointXYZ> grid;
+      grid.setLeafSize(static_cast<float>(pre.voxel_size), static_cast<float>(pre.voxel_size), static_cast<float>(pre.voxel_size));
+      grid.setInputCloud(cropped);
+      pcl::PointCloud<pcl::PointXYZ> out;
+      grid.filter(out);
+      kept = out.size();
+    }
+  } else {
+    for (auto _ : state) kept = preprocessScan(data().raw, pre).size();
+  }
+  state.counters["points"] = static_cast<double>(data().raw.size());
+  state.counters["kept"] = static_cast<double>(kept);
+}
+
 void backends(benchmark::internal::Benchmark* b) {
   b->Arg(static_cast<int>(NdtBackend::kPcl))->Arg(static_cast<int>(NdtBackend::kFast));
   b->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true)->UseRealTime();
@@ -91,6 +125,7 @@ void backends(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_AlignDense)->Apply(backends)->Iterations(3);
 BENCHMARK(BM_AlignAutowareSized)->Apply(backends)->Iterations(20);
 BENCHMARK(BM_BuildTargetAls)->Apply(backends)->Iterations(2);
+BENCHMARK(BM_PreprocessScan)->Apply(backends)->Iterations(50);
 
 
 }  // namespace
@@ -107,7 +142,8 @@ int main(int argc, char** argv) {
   const std::pair<const char*, const char*> cases[] = {
       {"BM_AlignDense", "HDL-32E pair, 0.1 m voxel source, identity"},
       {"BM_AlignAutowareSized", "HDL-32E, 1 m voxel source, 0.5 m / 2 deg off"},
-      {"BM_BuildTargetAls", "target build, ALS tile (487k points)"}};
+      {"BM_BuildTargetAls", "target build, ALS tile (487k points)"},
+      {"BM_PreprocessScan", "preprocessing the raw scan (crop, 3 m voxels)"}};
   for (const auto& [name, label] : cases) {
     auto& m = reporter.medians[name];
     if (!m.count(pcl) || !m.count(fast)) continue;

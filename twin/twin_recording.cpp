@@ -23,6 +23,7 @@
 #include "coloc/sim/roadside_perception.hpp"
 #include "coloc/sim/survey_map.hpp"
 #include "coloc/sim/vehicle_body.hpp"
+#include "coloc/replay/replay_cache.hpp"
 #include "coloc/replay/svg_plot.hpp"
 
 namespace coloc::twin {

@@ -10,13 +10,16 @@
 #include <string>
 #include <vector>
 
-#include "coloc/replay/replay_cache.hpp"
 #include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/sweep_cache.hpp"
 #include "coloc/sim/roadside_perception.hpp"
 #include "coloc/sim/scene.hpp"
+
+namespace coloc::replay {
+class RecordedLog;
+}  // namespace coloc::replay
 
 namespace coloc::twin {
 
