@@ -25,9 +25,10 @@ std::uint64_t bitsOf(double v) {
   return b;
 }
 
-template <typename T>
-void append(std::string& out, const T& value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
+// The values' bytes, one after the other (each a scalar or an Eigen vector: no padding inside).
+template <typename... T>
+void append(std::string& out, const T&... values) {
+  (out.append(reinterpret_cast<const char*>(&values), sizeof values), ...);
 }
 
 }  // namespace
@@ -100,29 +101,11 @@ std::string configFingerprint(const NdtPoseSourceConfig& c) {
   static_assert(sizeof(MapUpdateConfig) == 24, "MapUpdateConfig changed: fingerprint the new field");
   std::string out;
   const NdtConfig& n = c.ndt;
-  append(out, n.backend);
-  append(out, n.neighborhood);
-  append(out, n.resolution);
-  append(out, n.step_size);
-  append(out, n.transformation_epsilon);
-  append(out, n.max_iterations);
-  append(out, n.outlier_ratio);
-  append(out, n.threads);
-  append(out, n.nvtl_threshold);
-  append(out, n.max_oscillations);
-  append(out, n.covariance);
-  for (int i = 0; i < 6; ++i) append(out, n.fixed_covariance[i]);
+  append(out, n.backend, n.neighborhood, n.resolution, n.step_size, n.transformation_epsilon, n.max_iterations, n.outlier_ratio, n.threads,
+         n.nvtl_threshold, n.max_oscillations, n.covariance, n.fixed_covariance);
   const PreprocessConfig& p = c.preprocess;
-  append(out, p.min_range);
-  append(out, p.max_range);
-  append(out, p.deskew);
-  append(out, p.voxel_size);
-  append(out, p.max_points);
-  append(out, p.seed);
-  append(out, c.map.radius);
-  append(out, c.map.update_distance);
-  append(out, c.map.background);
-  for (int i = 0; i < 6; ++i) append(out, c.lidar_pose[i]);
+  append(out, p.min_range, p.max_range, p.deskew, p.voxel_size, p.max_points, p.seed);
+  append(out, c.map.radius, c.map.update_distance, c.map.background, c.lidar_pose);
   return out;
 }
 

@@ -282,8 +282,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   constexpr int kNoiseTrial = 499, kCalibrationTrial = 500, kNextTrial = 501;
   // First, per site, a drive that is never evaluated: on it the fixes' variance and the odometry's
   // covariance are measured against ground truth, as a surveyed vehicle would measure them.
-  // The first two sites' come first; each later site's follows the first trial of the site two before
-  // it: drives are replayed in this order, and a trial's replays then need not wait for the
+  // Those of the first two sites come first; each later site's follows the first trial of the site two
+  // before it: drives are replayed in this order, and a trial's replays then need not wait for the
   // calibration drive of a site they do not use (the order within the trials, and within the
   // calibration drives, is the tables' row order and stays as it was).
   std::vector<Drive> drives;
@@ -405,9 +405,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   auto launch = [&](std::size_t consumed) {
     while (launched < drives.size() && launched < consumed + kSimulatedAhead) {
       const std::size_t site = drives[launched].site;
-      bool surveying = false;  // an earlier drive of the site, not yet noted, is making its map
-      for (std::size_t e = 0; e < launched; ++e) surveying = surveying || (drives[e].site == site && maps[site].empty());
-      if (surveying) return;
+      // An earlier drive of the site, not yet noted, is making its map.
+      if (maps[site].empty() && std::any_of(drives.begin(), drives.begin() + launched, [&](const Drive& e) { return e.site == site; })) return;
       ahead.push_back(std::async(std::launch::async, record, launched++));
     }
   };
