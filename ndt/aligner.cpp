@@ -191,6 +191,87 @@ Matrix6d laplaceCovariance(const Matrix6d& hessian, const Vector6d& floor) {
   return covariance;
 }
 
+// The NVTL of the source at a pose: the mean over points near the map of their best voxel's score.
+double nvtlAt(const NdtTarget::Impl& t, const std::vector<Eigen::Vector3f>& source, const Vector6d& pose, const NdtConfig& config,
+              NeighbourCache* cache) {
+  ScoreOptions options;
+  options.nvtl = true;
+  options.gradient = false;
+  options.hessian = false;
+  options.threads = config.threads;
+  const ScoreEvaluation e = evaluateScore(t.voxels, config.resolution, t.constants, source, pose, options, cache);
+  return e.nvtl_points ? e.nvtl_sum / static_cast<double>(e.nvtl_points) : 0.0;
+}
+
+// The smallest symmetric matrix (in the floor's metric) that is at least both: the estimate's
+// eigenvalues, seen through the floor's whitening, clamped at 1.
+Eigen::Matrix2d floorCovariance(const Eigen::Matrix2d& estimate, const Eigen::Matrix2d& floor) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> f(floor);
+  const Eigen::Vector2d sd = f.eigenvalues().cwiseSqrt();
+  const Eigen::Matrix2d whiten = sd.cwiseInverse().asDiagonal() * f.eigenvectors().transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> w(whiten * estimate * whiten.transpose());
+  const Eigen::Vector2d clamped = w.eigenvalues().cwiseMax(1.0);
+  const Eigen::Matrix2d unwhiten = f.eigenvectors() * sd.asDiagonal();
+  return unwhiten * w.eigenvectors() * clamped.asDiagonal() * w.eigenvectors().transpose() * unwhiten.transpose();
+}
+
+// Autoware's MULTI_NDT_SCORE, with yaw probes: NVTL at offset poses, softmax weights (the optimum
+// included), weighted covariance of the probes' x/y and of their yaw, floored at the fixed matrix
+// (given in the vehicle frame, rotated into the map's).
+Matrix6d multiNdtScoreCovariance(const NdtTarget::Impl& t, const std::vector<Eigen::Vector3f>& source, const Vector6d& optimum, double nvtl,
+                                 const NdtConfig& config, NeighbourCache* cache) {
+  const Eigen::Matrix4d T = poseToMatrix(optimum);
+  const Eigen::Vector2d along = T.block<2, 1>(0, 0).normalized();
+  const Eigen::Vector2d across(-along.y(), along.x());
+  const Eigen::Matrix2d heading = (Eigen::Matrix2d() << along, across).finished();
+  // Autoware's initial_pose_offset_model, in the vehicle frame: x [0, 0, 0.5, -0.5, 1, -1], y [0.5, -0.5, 0, 0, 0, 0].
+  static const double kOffsets[6][2] = {{0.0, 0.5}, {0.0, -0.5}, {0.5, 0.0}, {-0.5, 0.0}, {1.0, 0.0}, {-1.0, 0.0}};
+  const auto weighted = [&](const std::vector<double>& scores) {
+    const double best = *std::max_element(scores.begin(), scores.end());
+    std::vector<double> w(scores.size());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < scores.size(); ++i) sum += w[i] = std::exp((scores[i] - best) / config.score_temperature);
+    for (double& x : w) x /= sum;
+    return w;
+  };
+
+  std::vector<Eigen::Vector2d> offsets{Eigen::Vector2d::Zero()};
+  std::vector<Eigen::Vector3d> shifts;
+  for (const auto& o : kOffsets) {
+    offsets.push_back(heading * Eigen::Vector2d(o[0], o[1]));
+    shifts.emplace_back(offsets.back().x(), offsets.back().y(), 0.0);
+  }
+  std::vector<double> scores = nvtlAtTranslations(t.voxels, config.resolution, t.constants, source, optimum, shifts, config.threads);
+  scores.insert(scores.begin(), nvtl);
+  std::vector<double> w = weighted(scores);
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < w.size(); ++i) mean += w[i] * offsets[i];
+  Eigen::Matrix2d xy = Eigen::Matrix2d::Zero();
+  for (std::size_t i = 0; i < w.size(); ++i) xy += w[i] * (offsets[i] - mean) * (offsets[i] - mean).transpose();
+
+  Matrix6d covariance = Matrix6d(config.fixed_covariance.asDiagonal());
+  const Eigen::Matrix2d floor = heading * covariance.topLeftCorner<2, 2>() * heading.transpose();
+  covariance.topLeftCorner<2, 2>() = floor.allFinite() ? floorCovariance(xy, floor) : floor;
+  if (config.score_yaw_offset_deg > 0.0) {
+    const double step = config.score_yaw_offset_deg * M_PI / 180.0;
+    std::vector<double> yaws{0.0};
+    std::vector<double> yaw_scores{nvtl};
+    for (const double k : {1.0, -1.0, 2.0, -2.0}) {
+      const Eigen::Matrix3d turn = Eigen::AngleAxisd(k * step, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::Matrix4d probe = T;
+      probe.topLeftCorner<3, 3>() = turn * T.topLeftCorner<3, 3>();
+      yaws.push_back(k * step);
+      yaw_scores.push_back(nvtlAt(t, source, matrixToPose(probe), config, cache));
+    }
+    w = weighted(yaw_scores);
+    double m = 0.0, var = 0.0;
+    for (std::size_t i = 0; i < w.size(); ++i) m += w[i] * yaws[i];
+    for (std::size_t i = 0; i < w.size(); ++i) var += w[i] * (yaws[i] - m) * (yaws[i] - m);
+    covariance(5, 5) = std::max(covariance(5, 5), var);
+  }
+  return covariance;
+}
+
 }  // namespace
 
 namespace {
@@ -224,12 +305,20 @@ AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, cons
   result.transform_probability = eval.score / static_cast<double>(source.size());
   result.nvtl = eval.nvtl_points ? eval.nvtl_sum / static_cast<double>(eval.nvtl_points) : 0.0;
 
-  Matrix6d covariance = config.covariance == CovarianceMode::kLaplace ? laplaceCovariance(eval.hessian, config.fixed_covariance)
-                                                                     : Matrix6d(config.fixed_covariance.asDiagonal());
-  // The fixed matrix is given in the vehicle frame; rotate its position block into the map frame.
-  const Eigen::Matrix3d R = result.transform.topLeftCorner<3, 3>();
-  if (config.covariance == CovarianceMode::kFixed)
-    covariance.topLeftCorner<3, 3>() = R * covariance.topLeftCorner<3, 3>() * R.transpose();
+  Matrix6d covariance;
+  switch (config.covariance) {
+    case CovarianceMode::kLaplace: covariance = laplaceCovariance(eval.hessian, config.fixed_covariance); break;
+    case CovarianceMode::kMultiNdtScore:
+      covariance = multiNdtScoreCovariance(t, source.points, opt.pose, result.nvtl, config, fast ? &cache : nullptr);
+      break;
+    case CovarianceMode::kFixed: {
+      // The fixed matrix is given in the vehicle frame; rotate its position block into the map frame.
+      const Eigen::Matrix3d R = result.transform.topLeftCorner<3, 3>();
+      covariance = Matrix6d(config.fixed_covariance.asDiagonal());
+      covariance.topLeftCorner<3, 3>() = R * covariance.topLeftCorner<3, 3>() * R.transpose();
+      break;
+    }
+  }
   result.covariance = covariance;
 
   std::ostringstream why;

@@ -30,6 +30,9 @@ void validate(const NdtPoseSourceConfig& c) {
   for (int i = 0; i < 6; ++i)
     require(c.ndt.fixed_covariance[i] > 0.0 && !std::isnan(c.ndt.fixed_covariance[i]), "fixed_covariance",
             "variances must be > 0 (.inf for not measured)");
+  require(std::isfinite(c.ndt.score_temperature) && c.ndt.score_temperature > 0.0, "score_temperature", "must be a finite number > 0");
+  require(std::isfinite(c.ndt.score_yaw_offset_deg) && c.ndt.score_yaw_offset_deg >= 0.0 && c.ndt.score_yaw_offset_deg <= 45.0,
+          "score_yaw_offset_deg", "must be in [0, 45] deg (0 = no yaw probes)");
   require(std::isfinite(c.preprocess.min_range) && c.preprocess.min_range >= 0.0, "min_range", "must be a finite number >= 0");
   positive(c.preprocess.max_range, "max_range");
   require(c.preprocess.min_range < c.preprocess.max_range, "min_range", "must be below max_range");

@@ -165,11 +165,17 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
       Vector3d b = Vector3d::Zero();
       Matrix3d A = Matrix3d::Zero();
       bool any = false;
+      // Over the radius neighbourhood the score visits exactly NVTL's voxels: NVTL is taken in the same
+      // pass, as the largest exponent (the score of a voxel rises with it, so exp of the largest is the
+      // same bits as the largest of the exps).
+      const bool nvtl_here = options.nvtl && options.neighborhood == Neighborhood::kRadius;
+      double best_exponent = 0.0;
       auto visit = [&](const Voxel& v) {
         const Vector3d q = xt - v.mean;
         if (options.neighborhood == Neighborhood::kRadius && q.squaredNorm() > radius_sq) return;
         const Vector3d Cq = v.inverse_covariance * q;
         const double exponent = -0.5 * k.d2 * q.dot(Cq);
+        if (nvtl_here && (!any || exponent > best_exponent)) best_exponent = exponent;
         any = true;
         // Beyond e^-40 (4e-18 of a voxel's full weight) a term cannot change a double sum of terms up
         // to 1: skipping it saves the exp and the derivatives of the many voxels a point barely touches.
@@ -203,7 +209,12 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
           local.hessian.bottomRightCorner<3, 3>() += angular;
         }
       }
-      if (options.nvtl) {
+      if (nvtl_here) {
+        if (any) {
+          local.nvtl_sum += -k.d1 * std::exp(best_exponent);
+          ++local.nvtl_points;
+        }
+      } else if (options.nvtl) {
         double best = 0.0;
         bool found = false;
         forRadius(idx, cell, thread, [&](const Voxel& v) {
@@ -232,6 +243,72 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < i; ++j) total.hessian(i, j) = total.hessian(j, i);
   return total;
+}
+
+std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolution, const ScoreConstants& k,
+                                       const std::vector<Eigen::Vector3f>& source, const Vector6d& pose,
+                                       const std::vector<Eigen::Vector3d>& translations, int threads_wanted) {
+  const std::size_t m = translations.size();
+  if (m == 0) return {};
+  const Eigen::Matrix3d R = poseToMatrix(pose).topLeftCorner<3, 3>();
+  const Vector3d t = pose.head<3>();
+  const double inverse_resolution = 1.0 / resolution;
+  const double radius_sq = resolution * resolution;
+  // Every voxel within reach of any of the shifted points lies in these cells around the point's own
+  // (a voxel's mean lies in its cell): one walk over them serves every translation.
+  Vector3d low = translations[0], high = translations[0];
+  for (const Vector3d& d : translations) {
+    low = low.cwiseMin(d);
+    high = high.cwiseMax(d);
+  }
+  low.array() -= resolution;
+  high.array() += resolution;
+  const int threads = threads_wanted > 0 ? threads_wanted : omp_get_max_threads();
+  const long n = static_cast<long>(source.size());
+  std::vector<std::vector<double>> sums(static_cast<std::size_t>(threads), std::vector<double>(m, 0.0));
+  std::vector<std::vector<std::size_t>> counts(static_cast<std::size_t>(threads), std::vector<std::size_t>(m, 0));
+#pragma omp parallel num_threads(threads)
+  {
+    const std::size_t thread = static_cast<std::size_t>(omp_get_thread_num());
+    std::vector<double> best(m);
+    std::vector<char> found(m);
+#pragma omp for schedule(static) nowait
+    for (long idx = 0; idx < n; ++idx) {
+      const Vector3d xt = R * source[static_cast<std::size_t>(idx)].cast<double>() + t;
+      const Eigen::Vector3i c0 = ((xt + low) * inverse_resolution).array().floor().cast<int>();
+      const Eigen::Vector3i c1 = ((xt + high) * inverse_resolution).array().floor().cast<int>();
+      std::fill(found.begin(), found.end(), 0);
+      for (int x = c0.x(); x <= c1.x(); ++x)
+        for (int y = c0.y(); y <= c1.y(); ++y)
+          for (int z = c0.z(); z <= c1.z(); ++z) {
+            const Voxel* v = voxels.find(Eigen::Vector3i(x, y, z));
+            if (!v) continue;
+            for (std::size_t j = 0; j < m; ++j) {
+              const Vector3d q = xt + translations[j] - v->mean;
+              if (q.squaredNorm() > radius_sq) continue;
+              const double exponent = -0.5 * k.d2 * q.dot(v->inverse_covariance * q);
+              if (!found[j] || exponent > best[j]) best[j] = exponent;
+              found[j] = 1;
+            }
+          }
+      for (std::size_t j = 0; j < m; ++j)
+        if (found[j]) {
+          sums[thread][j] += -k.d1 * std::exp(best[j]);
+          ++counts[thread][j];
+        }
+    }
+  }
+  std::vector<double> nvtl(m, 0.0);
+  for (std::size_t j = 0; j < m; ++j) {
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t th = 0; th < sums.size(); ++th) {
+      sum += sums[th][j];
+      count += counts[th][j];
+    }
+    nvtl[j] = count ? sum / static_cast<double>(count) : 0.0;
+  }
+  return nvtl;
 }
 
 }  // namespace coloc::ndt

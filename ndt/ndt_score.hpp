@@ -66,6 +66,13 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
                               const std::vector<Eigen::Vector3f>& source, const Vector6d& pose, const ScoreOptions& options,
                               NeighbourCache* cache = nullptr);
 
+/// NVTL of the source at `pose` shifted by each translation (map frame), over the radius
+/// neighbourhood: the same value per translation as evaluateScore's, in one walk over the voxels that
+/// any of the shifted points can reach.
+std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolution, const ScoreConstants& constants,
+                                       const std::vector<Eigen::Vector3f>& source, const Vector6d& pose,
+                                       const std::vector<Eigen::Vector3d>& translations, int threads = 0);
+
 /// Pose vector <-> homogeneous transform, in PCL's parametrisation.
 Eigen::Matrix4d poseToMatrix(const Vector6d& pose);
 Vector6d matrixToPose(const Eigen::Matrix4d& transform);

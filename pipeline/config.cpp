@@ -190,10 +190,19 @@ const std::vector<Key>& keys() {
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.nvtl_threshold = r.number(n, k); }},
       {"ndt", "max_oscillations", "", "steps reversing direction before a result is rejected", [](const C& c) { return show(c.ndt.source.ndt.max_oscillations); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.max_oscillations = static_cast<int>(r.integer(n, k, -1000000, 1000000)); }},
-      {"ndt", "covariance", "", "fixed (Autoware's matrix) or laplace (-H^-1 at the optimum, floored at the fixed one)",
-       [](const C& c) { return S(c.ndt.source.ndt.covariance == CovarianceMode::kFixed ? "fixed" : "laplace"); },
+      {"ndt", "covariance", "",
+       "fixed (Autoware's matrix), laplace (-H^-1 at the optimum) or multi_ndt_score (Autoware's: the score's spread over poses offset along, across and about the heading); the last two floored at the fixed one",
+       [](const C& c) { return S(covarianceModeName(c.ndt.source.ndt.covariance)); },
        [](const R& r, const N& n, const S& k, C& c) {
-         c.ndt.source.ndt.covariance = r.choice(n, k, {"fixed", "laplace"}) == "fixed" ? CovarianceMode::kFixed : CovarianceMode::kLaplace; }},
+         const S mode = r.choice(n, k, {"fixed", "laplace", "multi_ndt_score"});
+         for (const CovarianceMode m : {CovarianceMode::kFixed, CovarianceMode::kLaplace, CovarianceMode::kMultiNdtScore})
+           if (mode == covarianceModeName(m)) c.ndt.source.ndt.covariance = m; }},
+      {"ndt", "score_temperature", "", "multi_ndt_score: softmax temperature on NVTL (an offset pose this much below the optimum weighs 1/e)",
+       [](const C& c) { return show(c.ndt.source.ndt.score_temperature); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.score_temperature = r.number(n, k); }},
+      {"ndt", "score_yaw_offset_deg", "deg", "multi_ndt_score: yaw probes at +-1 and +-2 times this; 0 = x/y only (Autoware)",
+       [](const C& c) { return show(c.ndt.source.ndt.score_yaw_offset_deg); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.score_yaw_offset_deg = r.number(n, k); }},
       {"ndt", "fixed_covariance", "m^2, rad^2", "variances x, y, z, roll, pitch, yaw of the fixed covariance", [](const C& c) { return yamlList(c.ndt.source.ndt.fixed_covariance); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.fixed_covariance = readVariances(r, n, k); }},
       {"ndt", "min_range", "m", "scan points closer than this are dropped (the vehicle itself)", [](const C& c) { return show(c.ndt.source.preprocess.min_range); },

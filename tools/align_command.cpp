@@ -19,7 +19,7 @@ void addAlignCommand(CLI::App& app) {
                                                neighborhood = d.neighborhood == ndt::Neighborhood::kRadius  ? "radius"
                                                               : d.neighborhood == ndt::Neighborhood::kFace7 ? "face7"
                                                                                                             : "single",
-                                               covariance = d.covariance == ndt::CovarianceMode::kFixed ? "fixed" : "laplace";
+                                               covariance = ndt::covarianceModeName(d.covariance);
   static std::vector<double> init;
   static double resolution = d.resolution, step = d.step_size, epsilon = d.transformation_epsilon, source_voxel = 0.1,
                 nvtl_threshold = d.nvtl_threshold;
@@ -36,7 +36,8 @@ void addAlignCommand(CLI::App& app) {
   cmd->add_option("--max-iterations", iterations, "iteration limit")->capture_default_str();
   cmd->add_option("--source-voxel", source_voxel, "voxel size the source is downsampled with, m (0 = none)")->capture_default_str();
   cmd->add_option("--nvtl-threshold", nvtl_threshold, "quality gate on the result")->capture_default_str();
-  cmd->add_option("--covariance", covariance, "fixed or laplace")->check(CLI::IsMember({"fixed", "laplace"}))->capture_default_str();
+  cmd->add_option("--covariance", covariance, "fixed, laplace or multi_ndt_score")
+      ->check(CLI::IsMember({"fixed", "laplace", "multi_ndt_score"}))->capture_default_str();
   cmd->add_option("--threads", threads, "fast backend threads (0 = all cores)")->capture_default_str();
   cmd->callback([] {
     ndt::NdtConfig config;
@@ -48,7 +49,8 @@ void addAlignCommand(CLI::App& app) {
     config.transformation_epsilon = epsilon;
     config.max_iterations = iterations;
     config.nvtl_threshold = nvtl_threshold;
-    config.covariance = covariance == "laplace" ? ndt::CovarianceMode::kLaplace : ndt::CovarianceMode::kFixed;
+    for (const auto mode : {ndt::CovarianceMode::kFixed, ndt::CovarianceMode::kLaplace, ndt::CovarianceMode::kMultiNdtScore})
+      if (covariance == ndt::covarianceModeName(mode)) config.covariance = mode;
     config.threads = threads;
     ndt::NdtPoseSourceConfig check;
     check.ndt = config;

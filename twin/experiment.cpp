@@ -466,7 +466,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (const auto& v = ndt_variance[drive.site]) {
         Vector6d& cov = job.config.ndt.source.ndt.fixed_covariance;
         cov[0] = cov[1] = (*v)[0];
-        cov[5] = (*v)[1];
+        if (config.ndt_covariance == NdtCovarianceSource::kEstimated) cov[5] = (*v)[1];
+        if (config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) job.config.ndt.source.ndt.covariance = ndt::CovarianceMode::kMultiNdtScore;
       }
       if (config.twist_covariance_estimated) {
         pipeline::InputConfig twist;
@@ -528,7 +529,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       }
       twist_variance[drive.site] = odometryVariance(summary.odometry, scenario.name);
       // NDT alone on this drive, against ground truth: its covariance for the evaluated drives.
-      if (config.ndt_covariance_estimated) jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
+      if (config.ndt_covariance != NdtCovarianceSource::kPublished) jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
       for (const sim::ScenarioRsu& r : scenario.rsus)
         if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end())
           results.ideal_comparison[scenario.name + " " + r.lidar_model] = f->second;

@@ -69,7 +69,13 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     else if (key == "smoother") c.smoother = r.flag(v, key);
     else if (key == "recordings") c.recordings = r.flag(v, key);
     else if (key == "twist_covariance") c.twist_covariance_estimated = r.choice(v, key, {"estimated", "message"}) == "estimated";
-    else if (key == "ndt_covariance") c.ndt_covariance_estimated = r.choice(v, key, {"estimated", "published"}) == "estimated";
+    else if (key == "ndt_covariance") {
+      const std::string source = r.choice(v, key, {"estimated", "estimated_position", "multi_ndt_score", "published"});
+      c.ndt_covariance = source == "estimated"            ? NdtCovarianceSource::kEstimated
+                         : source == "estimated_position" ? NdtCovarianceSource::kEstimatedPosition
+                         : source == "multi_ndt_score"    ? NdtCovarianceSource::kMultiNdtScore
+                                                          : NdtCovarianceSource::kPublished;
+    }
     else if (key == "calibration") c.calibration = r.flag(v, key);
     else if (key == "rsu_calibration") c.calibrate_rsus = r.choice(v, key, {"noise_drive", "none"}) == "noise_drive";
     else if (key == "error_sources") c.ideal_twin = r.choice(v, key, {"real", "ideal"}) == "ideal";

@@ -33,7 +33,7 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_EQ(c.rsu_covariance, RsuCovariance::kEstimated);
   EXPECT_EQ(referenceCovariance(c.rsu_covariance), RsuCovariance::kPublished);
   EXPECT_EQ(c.gate_recovery, 3);
-  EXPECT_FALSE(c.ndt_covariance_estimated);
+  EXPECT_EQ(c.ndt_covariance, NdtCovarianceSource::kMultiNdtScore);
   EXPECT_FALSE(c.twist_covariance_estimated);
   EXPECT_TRUE(c.errors.empty());
   EXPECT_FALSE(c.recordings);  // the drives are replayed from memory unless asked
@@ -53,12 +53,14 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_TRUE(parseExperimentConfig("error_sources: ideal\n", "exp.yaml").ideal_twin);
   EXPECT_FALSE(parseExperimentConfig("rsu_calibration: none\n", "exp.yaml").calibrate_rsus);
   EXPECT_NE(errorOf("error_sources: perfect\n").find("error_sources: expected one of real, ideal"), std::string::npos);
-  EXPECT_TRUE(parseExperimentConfig("ndt_covariance: estimated\n", "exp.yaml").ndt_covariance_estimated);
+  EXPECT_EQ(parseExperimentConfig("ndt_covariance: estimated\n", "exp.yaml").ndt_covariance, NdtCovarianceSource::kEstimated);
+  EXPECT_EQ(parseExperimentConfig("ndt_covariance: estimated_position\n", "exp.yaml").ndt_covariance, NdtCovarianceSource::kEstimatedPosition);
+  EXPECT_EQ(parseExperimentConfig("ndt_covariance: multi_ndt_score\n", "exp.yaml").ndt_covariance, NdtCovarianceSource::kMultiNdtScore);
   EXPECT_NE(parseExperimentConfig("errors: {map_position_sd: 0}\n", "exp.yaml").errors.find("map_position_sd"), std::string::npos);
   EXPECT_NE(errorOf("trials: 2\nerrors: {map_position_sd: 9}\n").find("exp.yaml:2: errors.map_position_sd"), std::string::npos)
       << errorOf("trials: 2\nerrors: {map_position_sd: 9}\n");
   EXPECT_NE(errorOf("errors: {smog: 1}\n").find("errors.smog: unknown key"), std::string::npos);
-  EXPECT_NE(errorOf("ndt_covariance: laplace\n").find("ndt_covariance: expected one of estimated, published"), std::string::npos);
+  EXPECT_NE(errorOf("ndt_covariance: laplace\n").find("ndt_covariance: expected one of estimated, estimated_position, multi_ndt_score, published"), std::string::npos);
   EXPECT_NE(errorOf("rsu_calibration: yes\n").find("rsu_calibration: expected one of noise_drive, none"), std::string::npos);
   EXPECT_TRUE(parseExperimentConfig("recordings: true\n", "exp.yaml").recordings);
   EXPECT_NE(errorOf("recordings: often\n").find("exp.yaml:1: recordings"), std::string::npos) << errorOf("recordings: often\n");
@@ -67,7 +69,7 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
 TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideIt) {
   const ExperimentConfig c = loadExperimentConfig(COLOC_SOURCE_DIR "/config/experiments/paper_configuration.yaml");
   EXPECT_EQ(c.rsu_covariance, RsuCovariance::kPublished);
-  EXPECT_FALSE(c.ndt_covariance_estimated);
+  EXPECT_EQ(c.ndt_covariance, NdtCovarianceSource::kPublished);
   EXPECT_FALSE(c.twist_covariance_estimated);
   const pipeline::Config fuse = pipeline::loadConfig(c.fuse_config);
   EXPECT_FALSE(fuse.fusion.pose_time_alignment);  // Autoware's nearest tick

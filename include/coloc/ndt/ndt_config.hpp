@@ -20,7 +20,23 @@ enum class Neighborhood {
 enum class CovarianceMode {
   kFixed,    ///< Autoware's fixed matrix, rotated into the map frame
   kLaplace,  ///< -H^-1 of the score's Hessian at the optimum, floored at the fixed matrix
+  /// Autoware's MULTI_NDT_SCORE: the NVTL at poses offset from the optimum along and across the
+  /// heading (Autoware's offsets: 0.5 and 1 m along, 0.5 m across) and, unlike Autoware, turned about
+  /// it (`score_yaw_offset_deg`); their softmax weights give a weighted covariance of x/y and yaw,
+  /// floored at the fixed matrix. It sees a score that is flat along a direction, which the Hessian at
+  /// the optimum does not: repeated structure curves the score locally but holds nothing in place.
+  kMultiNdtScore,
 };
+
+/// The configuration's word for each mode (`ndt.covariance`, `coloc align --covariance`).
+inline const char* covarianceModeName(CovarianceMode mode) {
+  switch (mode) {
+    case CovarianceMode::kFixed: return "fixed";
+    case CovarianceMode::kLaplace: return "laplace";
+    case CovarianceMode::kMultiNdtScore: return "multi_ndt_score";
+  }
+  return "?";
+}
 
 struct NdtConfig {
   NdtBackend backend = NdtBackend::kFast;
@@ -40,6 +56,16 @@ struct NdtConfig {
   CovarianceMode covariance = CovarianceMode::kFixed;
   /// x, y, z, roll, pitch, yaw variances (m^2, rad^2) of the fixed covariance.
   Vector6d fixed_covariance = (Vector6d() << 0.0225, 0.0225, 0.0225, 0.000625, 0.000625, 0.000625).finished();
+  /// multi_ndt_score: the softmax temperature on NVTL: an offset whose NVTL is this much below the
+  /// optimum's weighs 1/e of it. Autoware's 0.05 makes the ground of an open road, which scores alike
+  /// a metre along, outweigh the structure that holds the scan (10-50 cm along the road where NDT is
+  /// within 2 cm); 0.02 keeps the floor there and still sees the open stretch of the twin's site B,
+  /// where 0.01 no longer does (README, "The filter against its best input").
+  double score_temperature = 0.02;
+  /// multi_ndt_score: yaw probes at +-1 and +-2 times this (deg); 0 = x/y only, as Autoware. Equal
+  /// weights over five probes give a variance of 2 x this squared, so they matter only under a yaw
+  /// floor below that (Autoware's fixed yaw is 1.4 deg: off by default, four score evaluations saved).
+  double score_yaw_offset_deg = 0.0;
 };
 
 }  // namespace coloc::ndt
