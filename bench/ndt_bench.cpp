@@ -3,7 +3,8 @@
 //  - Autoware-sized input (~1,000-1,500 points) from a 0.5 m / 2 deg initial offset;
 //  - building the target from the 487k-point airborne tile;
 //  - preprocessing the raw scan as the pipeline does (range crop, 3 m voxels): pcl::VoxelGrid after a
-//    crop, as Autoware's downsampling does, against coloc's one pass.
+//    crop, as Autoware's downsampling does, against coloc's one pass;
+//  - the Autoware-sized alignment with each covariance (fixed, laplace, multi_ndt_score).
 // Ends with a table of medians, ratios and the pose agreement of the two backends.
 //
 //   build/bench/ndt_bench
@@ -12,6 +13,7 @@
 #include "median_collector.hpp"
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -118,6 +120,18 @@ void BM_PreprocessScan(benchmark::State& state) {
   state.counters["kept"] = static_cast<double>(kept);
 }
 
+// The fast backend's alignment with each covariance (argument: CovarianceMode), Autoware-sized input:
+// what the covariance adds to a scan's cost.
+void BM_CovarianceAutowareSized(benchmark::State& state) {
+  NdtConfig config;
+  config.covariance = static_cast<CovarianceMode>(state.range(0));
+  const NdtTarget target(data().target, config);
+  AlignResult r;
+  for (auto _ : state) r = align(target, data().source_autoware, data().offset_guess, config);
+  state.counters["sd_x_cm"] = 100.0 * std::sqrt(r.covariance(0, 0));
+  state.counters["sd_y_cm"] = 100.0 * std::sqrt(r.covariance(1, 1));
+}
+
 void backends(benchmark::internal::Benchmark* b) {
   b->Arg(static_cast<int>(NdtBackend::kPcl))->Arg(static_cast<int>(NdtBackend::kFast));
   b->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true)->UseRealTime();
@@ -126,6 +140,11 @@ BENCHMARK(BM_AlignDense)->Apply(backends)->Iterations(3);
 BENCHMARK(BM_AlignAutowareSized)->Apply(backends)->Iterations(20);
 BENCHMARK(BM_BuildTargetAls)->Apply(backends)->Iterations(2);
 BENCHMARK(BM_PreprocessScan)->Apply(backends)->Iterations(50);
+BENCHMARK(BM_CovarianceAutowareSized)
+    ->Arg(static_cast<int>(CovarianceMode::kFixed))
+    ->Arg(static_cast<int>(CovarianceMode::kLaplace))
+    ->Arg(static_cast<int>(CovarianceMode::kMultiNdtScore))
+    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true)->UseRealTime()->Iterations(20);
 
 
 }  // namespace
@@ -149,6 +168,13 @@ int main(int argc, char** argv) {
     if (!m.count(pcl) || !m.count(fast)) continue;
     std::printf("%-44s %10.2f %10.2f %7.1fx\n", label, m[pcl], m[fast], m[pcl] / m[fast]);
   }
+  auto& cov = reporter.medians["BM_CovarianceAutowareSized"];
+  const std::string fixed = std::to_string(static_cast<int>(CovarianceMode::kFixed));
+  if (cov.count(fixed))
+    for (const CovarianceMode mode : {CovarianceMode::kLaplace, CovarianceMode::kMultiNdtScore})
+      if (const auto m = cov.find(std::to_string(static_cast<int>(mode))); m != cov.end())
+        std::printf("alignment with covariance %-16s %.3f ms against %.3f ms fixed (%.2fx), 1 m voxel source\n", covarianceModeName(mode), m->second,
+                    cov[fixed], m->second / cov[fixed]);
   for (const char* which : {"dense", "autoware"}) {
     const auto a = final_pose.find(std::string(which) + "/" + pcl), b = final_pose.find(std::string(which) + "/" + fast);
     if (a == final_pose.end() || b == final_pose.end()) continue;

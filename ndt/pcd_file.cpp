@@ -2,12 +2,14 @@
 
 // PCD is read by coloc's own parser: PCL's reader crashes on some malformed files (seen on a file
 // with no header), and a map loader must survive whatever is on the disk.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 
 #include "coloc/core/error.hpp"
@@ -98,6 +100,7 @@ Header parseHeader(const std::string& path, const std::string& bytes) {
     f.offset = h.point_step;
     h.point_step += static_cast<std::size_t>(f.size) * static_cast<std::size_t>(f.count);
   }
+  if (h.height != 0 && h.width > std::numeric_limits<std::size_t>::max() / h.height) fail(path, "header WIDTH x HEIGHT is out of range");
   if (h.points == 0) h.points = h.width * h.height;
   if (h.points != h.width * h.height) fail(path, "header POINTS differs from WIDTH x HEIGHT");
   return h;
@@ -180,9 +183,11 @@ PointCloud loadPcd(const std::string& path, PcdLoadReport* report) {
   // Values of field f for point i, whatever the layout.
   std::vector<double> values[4];
   const Field* wanted[4] = {fx, fy, fz, ft};
-  for (auto& v : values) v.reserve(n);
-  const std::uint8_t* data = reinterpret_cast<const std::uint8_t*>(bytes.data()) + h.data_start;
   const std::size_t available = bytes.size() - std::min(bytes.size(), h.data_start);
+  // The header's count is a claim: a point takes at least a byte, so no more than the data could hold
+  // is reserved up front (the data's own checks below say what is missing).
+  for (auto& v : values) v.reserve(std::min(n, available));
+  const std::uint8_t* data = reinterpret_cast<const std::uint8_t*>(bytes.data()) + h.data_start;
   const std::string truncated = "not a readable PCD file (corrupt or truncated header or data): ";
   if (h.data == "ascii") {
     // One value per element, fields in header order: the column of each wanted field's first element.
@@ -214,7 +219,7 @@ PointCloud loadPcd(const std::string& path, PcdLoadReport* report) {
     }
     if (read < n) fail(path, truncated + "ascii data ends after " + std::to_string(read) + " of " + std::to_string(n) + " points");
   } else if (h.data == "binary") {
-    if (available < n * h.point_step) fail(path, truncated + "binary data is shorter than its header says");
+    if (h.point_step == 0 || n > available / h.point_step) fail(path, truncated + "binary data is shorter than its header says");
     for (std::size_t i = 0; i < n; ++i)
       for (int k = 0; k < 4; ++k)
         if (wanted[k]) values[k].push_back(readBinary(data + i * h.point_step + wanted[k]->offset, *wanted[k]));
@@ -224,7 +229,8 @@ PointCloud loadPcd(const std::string& path, PcdLoadReport* report) {
     std::memcpy(&compressed, data, 4);
     std::memcpy(&uncompressed, data + 4, 4);
     if (compressed > available - 8) fail(path, truncated + "compressed data is shorter than its size word says");
-    if (uncompressed != n * h.point_step) fail(path, truncated + "uncompressed size disagrees with the header");
+    if (h.point_step == 0 || n > std::numeric_limits<std::size_t>::max() / h.point_step || uncompressed != n * h.point_step)
+      fail(path, truncated + "uncompressed size disagrees with the header");
     const std::vector<std::uint8_t> raw = lzfDecompress(path, data + 8, compressed, uncompressed);
     // Field-major layout: all values of the first field, then all of the second, ...
     for (int k = 0; k < 4; ++k) {

@@ -86,6 +86,20 @@ TEST(PcdFile, AFileEndingOnItsDataLineIsAnErrorNotACrash) {
   expectLoadError(COLOC_SOURCE_DIR "/test/support/fuzz_findings/pcd_data_line_ends_the_file.pcd", "not a readable PCD file");
 }
 
+// Found by fuzzing (pcd_fuzzer): WIDTH 4 x HEIGHT 1555555555555555 made the reader reserve room for
+// every claimed point before reading any, and the allocation failed.
+TEST(PcdFile, AHeaderClaimingMorePointsThanTheDataHoldsIsAnErrorNotAnAllocation) {
+  expectLoadError(COLOC_SOURCE_DIR "/test/support/fuzz_findings/pcd_header_claims_six_quadrillion_points.pcd", "ascii data ends after");
+  testing::TempDir dir;
+  const std::string header = "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nVIEWPOINT 0 0 0 1 0 0 0\n";
+  // A count whose bytes (x 12) wrap around 2^64 to fewer than the data holds.
+  const std::string wraps = "1537228672809129302";  // 12 x this = 2^64 + 8
+  writeText(dir / "wraps.pcd", header + "WIDTH " + wraps + "\nHEIGHT 1\nPOINTS " + wraps + "\nDATA binary\n" + std::string(24, '\0'));
+  expectLoadError(dir / "wraps.pcd", "binary data is shorter than its header says");
+  writeText(dir / "product.pcd", header + "WIDTH 4294967296\nHEIGHT 4294967297\nDATA ascii\n1 2 3\n");
+  expectLoadError(dir / "product.pcd", "WIDTH x HEIGHT is out of range");
+}
+
 TEST(PcdFile, TruncatedBinaryFileIsAnErrorNotACrash) {
   testing::TempDir dir;
   std::ifstream in(testing::realData("hdl32e_pair/target.pcd"), std::ios::binary);
