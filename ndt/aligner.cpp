@@ -221,7 +221,9 @@ Eigen::Matrix2d floorCovariance(const Eigen::Matrix2d& estimate, const Eigen::Ma
 Matrix6d multiNdtScoreCovariance(const NdtTarget::Impl& t, const std::vector<Eigen::Vector3f>& source, const Vector6d& optimum, double nvtl,
                                  const NdtConfig& config, NeighbourCache* cache) {
   const Eigen::Matrix4d T = poseToMatrix(optimum);
-  const Eigen::Vector2d along = T.block<2, 1>(0, 0).normalized();
+  // The heading in the map's plane (a sensor looking straight up or down has none: the map's x then).
+  const Eigen::Vector2d forward = T.block<2, 1>(0, 0);
+  const Eigen::Vector2d along = forward.norm() > 1e-9 ? Eigen::Vector2d(forward.normalized()) : Eigen::Vector2d::UnitX();
   const Eigen::Vector2d across(-along.y(), along.x());
   const Eigen::Matrix2d heading = (Eigen::Matrix2d() << along, across).finished();
   // Autoware's initial_pose_offset_model, in the vehicle frame: x [0, 0, 0.5, -0.5, 1, -1], y [0.5, -0.5, 0, 0, 0, 0].

@@ -655,7 +655,15 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         md << (first ? "" : ", ") << site << fmt(" %.1f cm", 100 * std::sqrt(v[0])) << fmt(" and %.2f deg", std::sqrt(v[1]) * 180.0 / M_PI);
         first = false;
       }
-      md << " (Autoware's fixed matrix says 15 cm and 1.4 deg).";
+      md << " (Autoware's fixed matrix says 15 cm and 1.4 deg). The filter takes it ";
+      switch (c.ndt_covariance) {
+        case NdtCovarianceSource::kMultiNdtScore:
+          md << "as the floor of NDT's covariance from its score (x/y raised where the score is flat along a direction; yaw Autoware's).";
+          break;
+        case NdtCovarianceSource::kEstimatedPosition: md << "for NDT's x/y covariance (yaw Autoware's)."; break;
+        case NdtCovarianceSource::kEstimated: md << "for NDT's x/y and yaw covariance."; break;
+        case NdtCovarianceSource::kPublished: md << "nowhere (Autoware's fixed matrix is used)."; break;
+      }
     }
     md << "\n\n";
   }
