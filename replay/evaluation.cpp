@@ -28,7 +28,7 @@ std::vector<ErrorSample> evaluate(const std::vector<io::TrajectoryPoint>& estima
       const Eigen::Vector2d d = estimate - t->position;
       const Eigen::Vector2d ahead(std::cos(t->heading), std::sin(t->heading));
       errors.push_back({p.stamp, estimate, t->position, d.norm(), d.dot(ahead), ahead.x() * d.y() - ahead.y() * d.x(),
-                        wrapAngle(rollPitchYaw(p.pose.orientation)[2] - t->heading)});
+                        wrapAngle(rollPitchYaw(p.pose.orientation)[2] - t->heading), t->heading});
     }
   }
   return errors;

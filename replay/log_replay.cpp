@@ -222,6 +222,7 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   pipe.onPoseInput([&](const std::string& source, const PoseMeasurement& p) {
     result.pose_inputs.push_back({p.stamp, p.pose});
     result.pose_input_sources.push_back(source);
+    result.pose_input_covariances.push_back(p.covariance.topLeftCorner<2, 2>());
     if (keep) result.filter_poses.emplace_back(source, p);
   });
   if (keep)

@@ -86,3 +86,63 @@ TEST(Evaluation, InputComparisonWithNothingInCommonIsEmpty) {
 
 }  // namespace
 }  // namespace coloc::replay
+
+#include <fstream>
+#include <sstream>
+
+#include "coloc/replay/log_replay.hpp"
+#include "temp_dir.hpp"
+
+namespace coloc::replay {
+namespace {
+
+// The last two columns of input_error.csv: the standard deviation each input claimed along and across
+// the true heading, beside its error.
+TEST(Evaluation, InputErrorCsvGivesEachInputsClaimedDeviationAlongAndAcrossTheRoad) {
+  // Driving north; NDT claims 0.5 m east-west (across) and 2 cm north-south (along), then nothing east-west.
+  std::vector<io::TrajectoryPoint> truth;
+  for (int k = 0; k <= 100; ++k) {
+    io::TrajectoryPoint p;
+    p.stamp = fromSeconds(0.01 * k);
+    p.pose.position = Eigen::Vector3d(0.0, 0.1 * k, 0.0);
+    p.pose.orientation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+    truth.push_back(p);
+  }
+  ReplayResult r;
+  for (const double t : {0.3, 0.6}) {
+    io::TrajectoryPoint p;
+    p.stamp = fromSeconds(t);
+    p.pose.position = Eigen::Vector3d(0.01, 10.0 * t + 0.02, 0.0);
+    p.pose.orientation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+    r.pose_inputs.push_back(p);
+    r.pose_input_sources.push_back("ndt");
+  }
+  r.pose_input_covariances.push_back((Eigen::Matrix2d() << 0.25, 0.0, 0.0, 0.0004).finished());
+  r.pose_input_covariances.push_back((Eigen::Matrix2d() << std::numeric_limits<double>::infinity(), 0.0, 0.0, 0.0004).finished());
+  r.input_errors["ndt"] = evaluate(r.pose_inputs, truth, fromSeconds(0.05));
+  ASSERT_EQ(r.input_errors["ndt"].size(), 2u);
+  testing::TempDir dir;
+  const std::string path = dir / "input_error.csv";
+  r.writeInputErrorCsv(path);
+  std::ifstream in(path);
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_NE(header.find(",sd_along_m,sd_across_m"), std::string::npos) << header;
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_NEAR(std::stod(rows[0][7]), 0.02, 1e-6);   // along: 2 cm ahead
+  EXPECT_NEAR(std::stod(rows[0][8]), -0.01, 1e-6);  // across: 1 cm east is to the right
+  EXPECT_NEAR(std::stod(rows[0][10]), 0.02, 1e-6);
+  EXPECT_NEAR(std::stod(rows[0][11]), 0.5, 1e-6);
+  EXPECT_EQ(rows[1][10], "inf");  // an axis not measured: no claim along or across
+  EXPECT_EQ(rows[1][11], "inf");
+}
+
+}  // namespace
+}  // namespace coloc::replay

@@ -17,6 +17,7 @@ struct ErrorSample {
   /// constrain a direction, as spread in that direction.
   double along = 0.0, across = 0.0;
   double heading_error = 0.0;  ///< rad, the estimate's yaw minus the true yaw, wrapped
+  double truth_heading = 0.0;  ///< rad, the true yaw at the stamp (the direction "along" refers to)
 };
 
 struct ErrorStats {

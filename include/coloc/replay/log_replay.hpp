@@ -35,6 +35,7 @@ struct ReplayResult {
   std::vector<io::TrajectoryPoint> fused;          ///< the estimate at every tick
   std::vector<io::TrajectoryPoint> pose_inputs;    ///< every pose measurement fed (NDT, fixes, others), for plots
   std::vector<std::string> pose_input_sources;     ///< the source of each pose input
+  std::vector<Eigen::Matrix2d> pose_input_covariances;  ///< the x/y covariance each pose input claimed (map frame)
   /// Each pose source's own measurements against ground truth at their stamps (NDT's per-scan error
   /// beside the fused error: a filter should never be worse than its best input).
   std::map<std::string, std::vector<ErrorSample>> input_errors;
