@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace coloc::replay {
 
@@ -32,6 +33,12 @@ std::vector<ErrorSample> evaluate(const std::vector<io::TrajectoryPoint>& estima
     }
   }
   return errors;
+}
+
+Eigen::Vector2d alongAcrossDeviation(const Eigen::Matrix2d& covariance, double heading) {
+  if (!covariance.allFinite()) return Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  const Eigen::Vector2d ahead(std::cos(heading), std::sin(heading)), left(-ahead.y(), ahead.x());
+  return {std::sqrt(std::max(0.0, ahead.dot(covariance * ahead))), std::sqrt(std::max(0.0, left.dot(covariance * left)))};
 }
 
 std::vector<ErrorSample> evaluateAt(const std::vector<io::TrajectoryPoint>& estimates, const std::vector<Stamp>& stamps,

@@ -86,26 +86,26 @@ void ReplayResult::writeErrorCsv(const std::string& path) const {
   }
 }
 
+std::map<std::pair<std::string, Stamp>, Eigen::Matrix2d> ReplayResult::claimedCovariances() const {
+  std::map<std::pair<std::string, Stamp>, Eigen::Matrix2d> claimed;
+  for (std::size_t i = 0; i < pose_inputs.size() && i < pose_input_covariances.size() && i < pose_input_sources.size(); ++i)
+    claimed.emplace(std::make_pair(pose_input_sources[i], pose_inputs[i].stamp), pose_input_covariances[i]);
+  return claimed;
+}
+
 void ReplayResult::writeInputErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   // Beside each input's error, the standard deviation it claimed along and across the road: where a
   // source said it did not know (NDT on a featureless stretch) and where it was wrong while sure.
   out << "stamp_s,source,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg,sd_along_m,sd_across_m\n";
-  std::map<std::pair<std::string, Stamp>, Eigen::Matrix2d> claimed;
-  for (std::size_t i = 0; i < pose_inputs.size() && i < pose_input_covariances.size() && i < pose_input_sources.size(); ++i)
-    claimed.emplace(std::make_pair(pose_input_sources[i], pose_inputs[i].stamp), pose_input_covariances[i]);
+  const auto claimed = claimedCovariances();
   char line[400];
   for (const auto& [source, samples] : input_errors)
     for (const ErrorSample& s : samples) {
-      double sd_along = std::nan(""), sd_across = std::nan("");  // nan: no claim recorded for this stamp
-      if (const auto c = claimed.find({source, s.stamp}); c != claimed.end() && !c->second.allFinite()) {
-        sd_along = sd_across = std::numeric_limits<double>::infinity();  // an axis not measured leaks into both
-      } else if (c != claimed.end()) {
-        const Eigen::Vector2d ahead(std::cos(s.truth_heading), std::sin(s.truth_heading)), left(-ahead.y(), ahead.x());
-        sd_along = std::sqrt(std::max(0.0, ahead.dot(c->second * ahead)));
-        sd_across = std::sqrt(std::max(0.0, left.dot(c->second * left)));
-      }
+      const auto c = claimed.find({source, s.stamp});
+      const Eigen::Vector2d sd = c == claimed.end() ? Eigen::Vector2d::Constant(std::nan("")) : alongAcrossDeviation(c->second, s.truth_heading);
+      const double sd_along = sd[0], sd_across = sd[1];
       std::snprintf(line, sizeof line, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), source.c_str(),
                     s.estimate.x(), s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI, sd_along,
                     sd_across);

@@ -81,7 +81,7 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
   std::printf("  fused %zu poses (%.1f s) in %.3f s: %.0fx real time\n", r.fused.size(), toSeconds(r.last_stamp - r.first_stamp),
               r.wall_seconds, r.wall_seconds > 0 ? r.log_duration / r.wall_seconds : 0.0);
   std::printf("  wrote %s/{fused.tum, summary.json, trajectory.svg%s}\n", out_dir.c_str(),
-              r.errors.empty() ? "" : ", error.csv, error.svg, input_error.csv");
+              r.errors.empty() ? "" : ", error.csv, error.svg, input_error.csv, input_error.svg");
 }
 
 void writePlots(const ReplayResult& r, const std::string& dir, const std::string& log) {
@@ -100,15 +100,39 @@ void writePlots(const ReplayResult& r, const std::string& dir, const std::string
   map.series.push_back(series(r.fused, "fused", "#1f77b4", false));
   writeSvg(dir + "/trajectory.svg", map);
   if (r.errors.empty()) return;
-  Plot error;
-  error.title = "Position error against ground truth";
-  error.x_label = "time since start [s]";
-  error.y_label = "planar error [m]";
-  error.y_from_zero = true;
+  // Plots against time since the first error sample, from zero up.
+  const auto overTime = [](std::string title, std::string y_label) {
+    Plot p;
+    p.title = std::move(title);
+    p.x_label = "time since start [s]";
+    p.y_label = std::move(y_label);
+    p.y_from_zero = true;
+    return p;
+  };
+  Plot error = overTime("Position error against ground truth", "planar error [m]");
   PlotSeries e{"fused", {}, {}, "#1f77b4", false};
   for (const ErrorSample& s : r.errors) e.x.push_back(toSeconds(s.stamp - r.errors.front().stamp)), e.y.push_back(s.error);
   error.series.push_back(e);
   writeSvg(dir + "/error.svg", error);
+  if (r.input_errors.empty()) return;
+  // Each pose input's error beside the deviation it claimed: where it said it did not know, and where
+  // it was wrong while sure.
+  Plot inputs = overTime("Pose inputs against ground truth, and the deviation each claimed", "planar error, claimed 1-sigma [m]");
+  const auto claimed = r.claimedCovariances();
+  for (const auto& [source, samples] : r.input_errors) {
+    PlotSeries err{source + ": error", {}, {}, "", true}, sd{source + ": claimed", {}, {}, "", false};
+    for (const ErrorSample& s : samples) {
+      const double t = toSeconds(s.stamp - r.errors.front().stamp);
+      err.x.push_back(t), err.y.push_back(s.error);
+      if (const auto c = claimed.find({source, s.stamp}); c != claimed.end()) {
+        const Eigen::Vector2d d = alongAcrossDeviation(c->second, s.truth_heading);
+        if (d.allFinite()) sd.x.push_back(t), sd.y.push_back(d.norm());
+      }
+    }
+    inputs.series.push_back(err);
+    if (!sd.x.empty()) inputs.series.push_back(sd);
+  }
+  writeSvg(dir + "/input_error.svg", inputs);
 }
 
 }  // namespace

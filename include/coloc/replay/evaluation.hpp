@@ -20,6 +20,10 @@ struct ErrorSample {
   double truth_heading = 0.0;  ///< rad, the true yaw at the stamp (the direction "along" refers to)
 };
 
+/// The standard deviations an x/y covariance claims along a heading and across it; inf for both if an
+/// axis is not measured (it leaks into every direction but the exact axes).
+Eigen::Vector2d alongAcrossDeviation(const Eigen::Matrix2d& covariance, double heading);
+
 struct ErrorStats {
   double mean = 0.0, rmse = 0.0, max = 0.0;  ///< m, planar
   double along_mean = 0.0, across_mean = 0.0;  ///< m, signed: biases

@@ -9,6 +9,7 @@
 // What the filter held at each tick is what a vehicle would have had at that moment, and the same
 // log and config always give the same bytes.
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,8 @@ struct ReplayResult {
   void writeErrorCsv(const std::string& path) const;
   /// input_error.csv: every pose input's error against ground truth at its stamp, by source.
   void writeInputErrorCsv(const std::string& path) const;
+  /// The x/y covariance each pose input claimed, by source and stamp (the first at a stamp).
+  std::map<std::pair<std::string, Stamp>, Eigen::Matrix2d> claimedCovariances() const;
   ErrorStats errorStats() const { return replay::errorStats(errors); }
 };
 
