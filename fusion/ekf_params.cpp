@@ -1,6 +1,7 @@
 #include "coloc/fusion/ekf_params.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 
 namespace coloc::fusion {
 
@@ -38,7 +39,11 @@ const std::vector<EkfParam>& ekfParams() {
 std::string formatValue(const EkfParam& param, const EkfConfig& config) {
   char buffer[64];
   if (const auto* d = std::get_if<double EkfConfig::*>(&param.field)) {
-    std::snprintf(buffer, sizeof buffer, "%.10g", config.*(*d));
+    // Ten digits unless the value needs more to read back to the bit.
+    for (int precision = 10; precision <= 17; ++precision) {
+      std::snprintf(buffer, sizeof buffer, "%.*g", precision, config.*(*d));
+      if (std::strtod(buffer, nullptr) == config.*(*d)) break;
+    }
     std::string text = buffer;
     // YAML 1.2 reads "50" as an integer; keep floats recognisable as floats.
     if (text.find_first_of(".eEn") == std::string::npos) text += ".0";

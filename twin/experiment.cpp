@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
@@ -107,6 +109,26 @@ struct Job {
   std::optional<smoother::RsuCalibration> calibration;
   std::optional<rsu_client::RsuInfo> calibrated;  ///< the registry entry with the calibration found
 };
+
+// A replay's configuration beside the recorded drive, as `coloc fuse` takes it: the same log, map,
+// configuration and registry give the same result as the experiment's replay.
+void writeReplayConfig(const Job& job, const std::string& dir) {
+  std::string name;
+  for (const char ch : job.run.label()) {
+    if (std::isalnum(static_cast<unsigned char>(ch))) name += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    else if (!name.empty() && name.back() != '_') name += '_';
+  }
+  while (!name.empty() && name.back() == '_') name.pop_back();
+  fs::create_directories(dir);
+  pipeline::Config config = job.config;
+  if (job.registry) {
+    std::ofstream(dir + "/" + name + "_rsu.yaml") << job.registry->toYaml();
+    config.rsu.registry = name + "_rsu.yaml";
+  }
+  std::ofstream(dir + "/" + name + ".yaml") << pipeline::configYaml(
+      config, "# " + job.run.label() + ", as the experiment replayed it:\n# coloc fuse " + job.log + " --map " + job.map + " --config " + dir + "/" +
+                  name + ".yaml\n\n");
+}
 
 // A run's error along the drive from a replay's ground truth and error samples.
 void fillRun(ExperimentRun& run, const std::vector<io::TrajectoryPoint>& ground_truth, const std::vector<replay::ErrorSample>& errors,
@@ -605,6 +627,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     if (drive.variant.empty() && config.smoother)
       for (Job& j : jobs)
         if (j.run.variant.empty() && j.run.delay == 0.0 && j.run.loss == 0.0) j.smooth = true;
+    if (config.recordings)
+      for (const Job& j : jobs) writeReplayConfig(j, rec.out_dir + "/replays");
     const auto t1 = Clock::now();
     runJobs(jobs, config.jobs);
     for (Job& j : jobs) {

@@ -127,3 +127,54 @@ TEST(Config, MissingFileIsAnErrorNamingIt) {
 
 }  // namespace
 }  // namespace coloc::pipeline
+
+namespace coloc::pipeline {
+namespace {
+
+// What the experiment writes beside a recorded drive must replay exactly what it ran.
+TEST(Config, AnyConfigurationWrittenOutReadsBackToTheBit) {
+  Config c;
+  c.fusion.pose_gate_recovery = 3;
+  c.ndt.source.ndt.covariance = ndt::CovarianceMode::kMultiNdtScore;
+  c.ndt.source.ndt.fixed_covariance << 0.000776543210987, 0.000776543210987, 0.0225, 0.000625, 0.000625, kInfinity;
+  c.ndt.source.ndt.score_temperature = 1.0 / 3.0;
+  c.ndt.source.lidar_pose << 0.0, 0.0, 1.9, 0.0, 0.0, 0.0;
+  c.pipeline.initial_pose = Eigen::Vector4d(0.1, -1.75, 0.0, 0.1234567890123);
+  InputConfig fix;
+  fix.role = InputRole::kRsuFix;
+  fix.source = "/rsu/rsu_a/fix";
+  rsu_client::LinkConfig link;
+  link.delay = 0.03;
+  link.loss = 0.2;
+  link.seed = 7919ULL * 3 + 301;
+  fix.link = link;
+  c.inputs["/rsu/rsu_a/fix"] = fix;
+  InputConfig twist;
+  twist.role = InputRole::kTwist;
+  twist.source = "odometry";
+  twist.covariance_diagonal = (Vector6d() << 0.0024681357913, kInfinity, kInfinity, kInfinity, kInfinity, 2.9e-5).finished();
+  twist.additional_delay = 0.015;
+  c.inputs["/vehicle/twist"] = twist;
+
+  const std::string text = configYaml(c, "# written by a test\n");
+  const Config back = parseConfig(text, "written.yaml");
+  EXPECT_EQ(configYaml(back, "# written by a test\n"), text);
+  EXPECT_EQ(back.ndt.source.ndt.fixed_covariance, c.ndt.source.ndt.fixed_covariance);  // to the bit
+  EXPECT_EQ(back.ndt.source.ndt.score_temperature, 1.0 / 3.0);
+  EXPECT_EQ(back.ndt.source.ndt.covariance, ndt::CovarianceMode::kMultiNdtScore);
+  EXPECT_EQ(*back.pipeline.initial_pose, *c.pipeline.initial_pose);
+  ASSERT_EQ(back.inputs.size(), 2u);
+  const InputConfig& f = back.inputs.at("/rsu/rsu_a/fix");
+  EXPECT_EQ(f.role, InputRole::kRsuFix);
+  ASSERT_TRUE(f.link.has_value());
+  EXPECT_EQ(f.link->delay, 0.03);
+  EXPECT_EQ(f.link->loss, 0.2);
+  EXPECT_EQ(f.link->seed, link.seed);
+  const InputConfig& t = back.inputs.at("/vehicle/twist");
+  EXPECT_EQ(t.source, "odometry");
+  EXPECT_EQ(*t.covariance_diagonal, *twist.covariance_diagonal);
+  EXPECT_EQ(t.additional_delay, 0.015);
+}
+
+}  // namespace
+}  // namespace coloc::pipeline

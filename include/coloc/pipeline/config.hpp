@@ -144,6 +144,9 @@ Config parseConfig(const std::string& yaml_text, const std::string& source_name)
 /// The complete default configuration as YAML with a comment per key: `coloc config` prints it and
 /// config/coloc.yaml is this text.
 std::string defaultConfigYaml();
+/// Any configuration as a file `loadConfig` reads back to the same values (every number to the bit),
+/// inputs included, after `heading` (comment lines).
+std::string configYaml(const Config& config, const std::string& heading = "");
 
 /// The README's reference table (Markdown) of every key.
 std::string configReferenceMarkdown();
