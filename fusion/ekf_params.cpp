@@ -1,7 +1,6 @@
 #include "coloc/fusion/ekf_params.hpp"
 
-#include <cstdio>
-#include <cstdlib>
+#include "coloc/core/number_text.hpp"
 
 namespace coloc::fusion {
 
@@ -37,14 +36,8 @@ const std::vector<EkfParam>& ekfParams() {
 }
 
 std::string formatValue(const EkfParam& param, const EkfConfig& config) {
-  char buffer[64];
   if (const auto* d = std::get_if<double EkfConfig::*>(&param.field)) {
-    // Ten digits unless the value needs more to read back to the bit.
-    for (int precision = 10; precision <= 17; ++precision) {
-      std::snprintf(buffer, sizeof buffer, "%.*g", precision, config.*(*d));
-      if (std::strtod(buffer, nullptr) == config.*(*d)) break;
-    }
-    std::string text = buffer;
+    std::string text = exactNumberText(config.*(*d), 10);
     // YAML 1.2 reads "50" as an integer; keep floats recognisable as floats.
     if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
     return text;

@@ -34,11 +34,20 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// "VLP-32C" -> "vlp32c": a suffix for the RSU id, hence the topic.
-std::string slug(const std::string& lidar) {
+// Lower-case letters and digits, runs of anything else as `separator` (none by default):
+// "VLP-32C" -> "vlp32c", a suffix for the RSU id, hence the topic; with '_', a file name of a label.
+std::string slug(const std::string& text, const char* separator = "") {
   std::string s;
-  for (char c : lidar)
-    if (std::isalnum(static_cast<unsigned char>(c))) s += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  bool gap = false;
+  for (char c : text) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) {
+      gap = !s.empty();
+      continue;
+    }
+    if (gap) s += separator;
+    gap = false;
+    s += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
   return s;
 }
 
@@ -113,12 +122,7 @@ struct Job {
 // A replay's configuration beside the recorded drive, as `coloc fuse` takes it: the same log, map,
 // configuration and registry give the same result as the experiment's replay.
 void writeReplayConfig(const Job& job, const std::string& dir) {
-  std::string name;
-  for (const char ch : job.run.label()) {
-    if (std::isalnum(static_cast<unsigned char>(ch))) name += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    else if (!name.empty() && name.back() != '_') name += '_';
-  }
-  while (!name.empty() && name.back() == '_') name.pop_back();
+  const std::string name = slug(job.run.label(), "_");
   fs::create_directories(dir);
   pipeline::Config config = job.config;
   if (job.registry) {
