@@ -3,12 +3,15 @@
 //  - Autoware-sized input (~1,000-1,500 points) from a 0.5 m / 2 deg initial offset;
 //  - building the target from the 487k-point airborne tile;
 //  - preprocessing the raw scan as the pipeline does (range crop, 3 m voxels): pcl::VoxelGrid after a
-//    crop, as Autoware's downsampling does, against coloc's one pass;
+//    crop, as Autoware's downsampling does, against coloc's one pass; the same with per-point times and
+//    deskewing;
 //  - the Autoware-sized alignment with each covariance (fixed, laplace, multi_ndt_score).
 // Ends with a table of medians, ratios and the pose agreement of the two backends.
 //
 //   build/bench/ndt_bench
 #include <benchmark/benchmark.h>
+
+#include <algorithm>
 
 #include "median_collector.hpp"
 
@@ -92,6 +95,16 @@ void BM_BuildTargetAls(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(data().als.size());
 }
 
+// Points left by pcl::VoxelGrid at `leaf` (Autoware's downsampling).
+std::size_t pclVoxelGridSize(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud, double leaf) {
+  pcl::VoxelGrid<pcl::PointXYZ> grid;
+  grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
+  grid.setInputCloud(cloud);
+  pcl::PointCloud<pcl::PointXYZ> out;
+  grid.filter(out);
+  return out.size();
+}
+
 // Argument 0: pcl::VoxelGrid after a range crop; 1: coloc's preprocessScan (crop, deskew, voxels in one pass).
 void BM_PreprocessScan(benchmark::State& state) {
   PreprocessConfig pre;
@@ -106,17 +119,50 @@ void BM_PreprocessScan(benchmark::State& state) {
         const double r = p.cast<double>().squaredNorm();
         if (r >= lo && r <= hi) cropped->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
       }
-      pcl::VoxelGrid<pcl::PointXYZ> grid;
-      grid.setLeafSize(static_cast<float>(pre.voxel_size), static_cast<float>(pre.voxel_size), static_cast<float>(pre.voxel_size));
-      grid.setInputCloud(cropped);
-      pcl::PointCloud<pcl::PointXYZ> out;
-      grid.filter(out);
-      kept = out.size();
+      kept = pclVoxelGridSize(cropped, pre.voxel_size);
     }
   } else {
     for (auto _ : state) kept = preprocessScan(data().raw, pre).size();
   }
   state.counters["points"] = static_cast<double>(data().raw.size());
+  state.counters["kept"] = static_cast<double>(kept);
+}
+
+// The same with per-point times and the motion undone at 8 m/s, 0.1 rad/s, as the twin's and a driver's
+// scans reach the pipeline: in firing order, the lasers of a firing sharing its time (a 10 Hz sweep of
+// 1,800 firings, the firing from the point's azimuth). Argument 0: the crop and the deskew one point at a
+// time, then pcl::VoxelGrid; 1: coloc's preprocessScan.
+void BM_PreprocessScanDeskewed(benchmark::State& state) {
+  static const PointCloud timed = [] {
+    const PointCloud& raw = data().raw;
+    std::vector<std::pair<int, std::size_t>> order;
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      const Eigen::Vector3f& p = raw.points[i];
+      order.push_back({static_cast<int>(1800.0 * (std::atan2(p.y(), p.x()) + M_PI) / (2.0 * M_PI)) % 1800, i});
+    }
+    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    PointCloud c;
+    for (const auto& [firing, i] : order) {
+      c.points.push_back(raw.points[i]);
+      c.times.push_back(static_cast<float>(0.1 * firing / 1800.0));
+    }
+    return c;
+  }();
+  PreprocessConfig pre;
+  pre.max_points = 0;
+  std::size_t kept = 0;
+  if (state.range(0) == static_cast<int>(NdtBackend::kPcl)) {
+    for (auto _ : state) {
+      const PointCloud moved = deskew(cropRange(timed, pre.min_range, pre.max_range), 8.0, 0.1);
+      auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+      cloud->reserve(moved.size());
+      for (const Eigen::Vector3f& p : moved.points) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+      kept = pclVoxelGridSize(cloud, pre.voxel_size);
+    }
+  } else {
+    for (auto _ : state) kept = preprocessScan(timed, pre, 8.0, 0.1).size();
+  }
+  state.counters["points"] = static_cast<double>(timed.size());
   state.counters["kept"] = static_cast<double>(kept);
 }
 
@@ -140,6 +186,7 @@ BENCHMARK(BM_AlignDense)->Apply(backends)->Iterations(3);
 BENCHMARK(BM_AlignAutowareSized)->Apply(backends)->Iterations(20);
 BENCHMARK(BM_BuildTargetAls)->Apply(backends)->Iterations(2);
 BENCHMARK(BM_PreprocessScan)->Apply(backends)->Iterations(50);
+BENCHMARK(BM_PreprocessScanDeskewed)->Apply(backends)->Iterations(50);
 BENCHMARK(BM_CovarianceAutowareSized)
     ->Arg(static_cast<int>(CovarianceMode::kFixed))
     ->Arg(static_cast<int>(CovarianceMode::kLaplace))
@@ -162,7 +209,8 @@ int main(int argc, char** argv) {
       {"BM_AlignDense", "HDL-32E pair, 0.1 m voxel source, identity"},
       {"BM_AlignAutowareSized", "HDL-32E, 1 m voxel source, 0.5 m / 2 deg off"},
       {"BM_BuildTargetAls", "target build, ALS tile (487k points)"},
-      {"BM_PreprocessScan", "preprocessing the raw scan (crop, 3 m voxels)"}};
+      {"BM_PreprocessScan", "preprocessing the raw scan (crop, 3 m voxels)"},
+      {"BM_PreprocessScanDeskewed", "the same with per-point times, deskewed"}};
   for (const auto& [name, label] : cases) {
     auto& m = reporter.medians[name];
     if (!m.count(pcl) || !m.count(fast)) continue;

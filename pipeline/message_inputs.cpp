@@ -63,14 +63,35 @@ ndt::PointCloud toPointCloud(const io::PointCloud2& m) {
   // Drivers give per-point time as seconds (float) relative to the sweep, nanoseconds (uint32, Ouster)
   // or absolute seconds (float64): all become seconds relative to the first point.
   std::vector<double> times;
-  for (std::uint32_t row = 0; row < m.height; ++row)
-    for (std::uint32_t col = 0; col < m.width; ++col) {
-      const std::uint8_t* p = m.data.data() + static_cast<std::size_t>(row) * m.row_step + static_cast<std::size_t>(col) * m.point_step;
-      const double x = read(p + fx->offset, fx->datatype), y = read(p + fy->offset, fy->datatype), z = read(p + fz->offset, fz->datatype);
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
-      cloud.points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-      if (ft) times.push_back(read(p + ft->offset, ft->datatype));
+  if (ft) times.reserve(count);
+  const auto isFloat = [](const io::PointField* f) { return !f || f->datatype == io::PointField::kFloat32; };
+  if (isFloat(fx) && isFloat(fy) && isFloat(fz) && isFloat(ft)) {
+    // The common case (every driver's x, y, z; most drivers' time): float32 read as such, the same
+    // values as through read() and back to float, without a switch per field and point.
+    const auto get = [](const std::uint8_t* at) {
+      float v;
+      std::memcpy(&v, at, 4);
+      return v;
+    };
+    for (std::uint32_t row = 0; row < m.height; ++row) {
+      const std::uint8_t* p = m.data.data() + static_cast<std::size_t>(row) * m.row_step;
+      for (std::uint32_t col = 0; col < m.width; ++col, p += m.point_step) {
+        const float x = get(p + fx->offset), y = get(p + fy->offset), z = get(p + fz->offset);
+        if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+        cloud.points.emplace_back(x, y, z);
+        if (ft) times.push_back(get(p + ft->offset));
+      }
     }
+  } else {
+    for (std::uint32_t row = 0; row < m.height; ++row)
+      for (std::uint32_t col = 0; col < m.width; ++col) {
+        const std::uint8_t* p = m.data.data() + static_cast<std::size_t>(row) * m.row_step + static_cast<std::size_t>(col) * m.point_step;
+        const double x = read(p + fx->offset, fx->datatype), y = read(p + fy->offset, fy->datatype), z = read(p + fz->offset, fz->datatype);
+        if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+        cloud.points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+        if (ft) times.push_back(read(p + ft->offset, ft->datatype));
+      }
+  }
   if (ft && !times.empty()) {
     double first = times.front();
     for (double t : times) first = std::min(first, t);

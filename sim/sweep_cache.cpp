@@ -6,10 +6,18 @@ namespace coloc::sim {
 
 namespace {
 
-// FNV-1a over raw bytes: a fingerprint, not a defence against crafted input.
+// A fingerprint, not a defence against crafted input: 64-bit words folded in by multiply and shift.
+// A byte at a time (FNV-1a) it cost 1.5 % of an experiment's CPU: 1,800 poses are hashed per sweep.
+// Every value hashed here is a whole number of doubles; a tail of bytes is folded in one by one.
 void mix(std::uint64_t& h, const void* data, std::size_t size) {
   const auto* bytes = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) h = (h ^ bytes[i]) * 1099511628211ULL;
+  for (std::size_t i = 0; i + 8 <= size; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, bytes + i, 8);
+    h = (h ^ word) * 0x9E3779B97F4A7C15ULL;
+    h ^= h >> 29;
+  }
+  for (std::size_t i = size & ~std::size_t{7}; i < size; ++i) h = (h ^ bytes[i]) * 1099511628211ULL;
 }
 
 }  // namespace
