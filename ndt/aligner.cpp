@@ -159,7 +159,7 @@ Optimisation optimiseFast(const NdtTarget::Impl& target, const std::vector<Eigen
     std::vector<Eigen::Vector3f> coarse;
     coarse.reserve(source.size() / stride + 1);
     for (std::size_t i = 0; i < source.size(); i += stride) coarse.push_back(source[i]);
-    NeighbourCache coarse_cache(coarse.size(), config.resolution);
+    NeighbourCache coarse_cache(coarse.size(), *target.neighbours);
     iterate(target, coarse, config, coarse_cache, pose, radius, previous_step, out);
   }
   out.converged = iterate(target, source, config, cache, pose, radius, previous_step, out);
@@ -243,7 +243,7 @@ Matrix6d multiNdtScoreCovariance(const NdtTarget::Impl& t, const std::vector<Eig
     offsets.push_back(heading * Eigen::Vector2d(o[0], o[1]));
     shifts.emplace_back(offsets.back().x(), offsets.back().y(), 0.0);
   }
-  std::vector<double> scores = nvtlAtTranslations(t.voxels, config.resolution, t.constants, source, optimum, shifts, config.threads);
+  std::vector<double> scores = nvtlAtTranslations(t.voxels, config.resolution, t.constants, source, optimum, shifts, *t.neighbours, config.threads);
   scores.insert(scores.begin(), nvtl);
   std::vector<double> w = weighted(scores);
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -289,7 +289,7 @@ AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, cons
   }
   const auto start = Clock::now();
   // Which voxels each point can reach, remembered across the evaluations of this alignment.
-  NeighbourCache cache(source.size(), config.resolution);
+  NeighbourCache cache(source.size(), *t.neighbours);
   const bool fast = config.backend == NdtBackend::kFast;
   const Optimisation opt = fast ? optimiseFast(t, source.points, matrixToPose(guess), config, cache) : optimisePcl(t, source, guess);
   result.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();

@@ -3,7 +3,9 @@
 #include <omp.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
+#include <memory>
 #include <cmath>
 
 namespace coloc::ndt {
@@ -61,24 +63,9 @@ const std::vector<Eigen::Vector3i>& offsets(Neighborhood n) {
   return cube27;
 }
 
-// Appends the voxels of cell's 27-cell block whose means lie within one resolution of the cell's box,
-// in the 27-cell search's order. A point in the cell is nearer to a mean than the box is, so no voxel
-// within reach of a point is left out (the slack covers a point rounded onto the cell from outside).
-void gatherCell(const VoxelLookup& voxels, double resolution, const Eigen::Vector3i& cell, std::vector<std::uint32_t>& out) {
-  const Vector3d low = cell.cast<double>() * resolution, high = low + Vector3d::Constant(resolution);
-  const double reach = resolution * (1.0 + 1e-6), reach_sq = reach * reach;
-  for (const Eigen::Vector3i& offset : offsets(Neighborhood::kRadius)) {
-    const std::int64_t v = voxels.indexOf(cell + offset);
-    if (v < 0) continue;
-    const Vector3d& mean = voxels.voxels()[static_cast<std::size_t>(v)].mean;
-    if ((mean.cwiseMax(low).cwiseMin(high) - mean).squaredNorm() <= reach_sq) out.push_back(static_cast<std::uint32_t>(v));
-  }
-}
-
 }  // namespace
 
-NeighbourCache::NeighbourCache(std::size_t points, double resolution)
-    : resolution_(resolution), cell_(points, kNoCell), list_(points, 0), thread_(points, -1) {}
+NeighbourCache::NeighbourCache(std::size_t points, const CellNeighbours& cells) : cells_(&cells), cell_(points, kNoCell), list_(points) {}
 
 ScoreConstants scoreConstants(double resolution, double outlier_ratio) {
   // The mixture of a Gaussian and a uniform outlier density, approximated by one scaled Gaussian.
@@ -117,32 +104,26 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
   const std::vector<Eigen::Vector3i>& search = offsets(options.neighborhood);
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   const long n = static_cast<long>(source.size());
-  if (cache && (cache->cell_.size() != source.size() || cache->resolution_ != resolution)) cache = nullptr;  // not this alignment's
-  if (cache && cache->lists_.size() < static_cast<std::size_t>(threads)) cache->lists_.resize(static_cast<std::size_t>(threads));
+  if (cache && (cache->cell_.size() != source.size() || cache->cells_->resolution() != resolution)) cache = nullptr;  // not this alignment's
   const bool cached_search = cache && options.neighborhood == Neighborhood::kRadius;
   // Calls visit(voxel) for every voxel of the radius neighbourhood's 27 cells that can be within reach,
-  // from the cache when there is one.
-  auto forRadius = [&](long idx, const Eigen::Vector3i& cell, int thread, auto&& visit) {
+  // from the cache when there is one. `scratch`: the thread's, backing a list the target does not keep.
+  auto forRadius = [&](long idx, const Eigen::Vector3i& cell, std::vector<std::uint32_t>& scratch, auto&& visit) {
     if (!cache) {
       for (const Eigen::Vector3i& offset : offsets(Neighborhood::kRadius))
         if (const Voxel* v = voxels.find(cell + offset)) visit(*v);
       return;
     }
     const std::size_t i = static_cast<std::size_t>(idx);
-    NeighbourCache::Lists& lists = cache->lists_[static_cast<std::size_t>(thread)];
     const std::uint64_t key = VoxelLookup::pack(cell);
-    if (cache->cell_[i] != key || cache->thread_[i] != thread) {
-      const auto [list, inserted] = lists.cells.insert(key);
-      if (inserted) {
-        gatherCell(voxels, resolution, cell, lists.voxels);
-        lists.begin.push_back(static_cast<std::uint32_t>(lists.voxels.size()));
-      }
-      cache->cell_[i] = key;
-      cache->list_[i] = static_cast<std::uint32_t>(list);
-      cache->thread_[i] = thread;
+    if (cache->cell_[i] != key) {
+      const CellNeighbours::List list = cache->cells_->get(cell, key, scratch);
+      const bool kept = list.size == 0 || list.voxels != scratch.data();
+      cache->cell_[i] = kept ? key : NeighbourCache::kNoCell;
+      cache->list_[i] = list;
     }
-    const std::uint32_t n = cache->list_[i];
-    for (std::uint32_t k = lists.begin[n]; k < lists.begin[n + 1]; ++k) visit(voxels.voxels()[lists.voxels[k]]);
+    const CellNeighbours::List& list = cache->list_[i];
+    for (std::uint32_t k = 0; k < list.size; ++k) visit(voxels.voxels()[list.voxels[k]]);
   };
 
   // One partial sum per thread, added in thread order afterwards: with a static schedule the result is
@@ -152,6 +133,7 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
   {
     const int thread = omp_get_thread_num();
     ScoreEvaluation& local = partial[static_cast<std::size_t>(thread)];
+    std::vector<std::uint32_t> scratch;
 #pragma omp for schedule(static) nowait
     for (long idx = 0; idx < n; ++idx) {
       const Vector3d x = source[static_cast<std::size_t>(idx)].cast<double>();
@@ -188,7 +170,7 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
         if (options.hessian) A.noalias() += f * (v.inverse_covariance - k.d2 * Cq * Cq.transpose());
       };
       if (cached_search) {
-        forRadius(idx, cell, thread, visit);
+        forRadius(idx, cell, scratch, visit);
       } else {
         for (const Eigen::Vector3i& offset : search)
           if (const Voxel* v = voxels.find(cell + offset)) visit(*v);
@@ -217,7 +199,7 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
       } else if (options.nvtl) {
         double best = 0.0;
         bool found = false;
-        forRadius(idx, cell, thread, [&](const Voxel& v) {
+        forRadius(idx, cell, scratch, [&](const Voxel& v) {
           const Vector3d q = xt - v.mean;
           if (q.squaredNorm() > radius_sq) return;
           const double s = -k.d1 * std::exp(-0.5 * k.d2 * q.dot(v.inverse_covariance * q));
@@ -247,22 +229,18 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
 
 std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolution, const ScoreConstants& k,
                                        const std::vector<Eigen::Vector3f>& source, const Vector6d& pose,
-                                       const std::vector<Eigen::Vector3d>& translations, int threads_wanted) {
+                                       const std::vector<Eigen::Vector3d>& translations, const CellNeighbours& target_cells,
+                                       int threads_wanted) {
   const std::size_t m = translations.size();
   if (m == 0) return {};
+  // The lists of a target built at another resolution do not describe this one's reach.
+  std::unique_ptr<CellNeighbours> own;
+  if (target_cells.resolution() != resolution) own = std::make_unique<CellNeighbours>(voxels, resolution);
+  const CellNeighbours& cells = own ? *own : target_cells;
   const Eigen::Matrix3d R = poseToMatrix(pose).topLeftCorner<3, 3>();
   const Vector3d t = pose.head<3>();
   const double inverse_resolution = 1.0 / resolution;
   const double radius_sq = resolution * resolution;
-  // Every voxel within reach of any of the shifted points lies in these cells around the point's own
-  // (a voxel's mean lies in its cell): one walk over them serves every translation.
-  Vector3d low = translations[0], high = translations[0];
-  for (const Vector3d& d : translations) {
-    low = low.cwiseMin(d);
-    high = high.cwiseMax(d);
-  }
-  low.array() -= resolution;
-  high.array() += resolution;
   const int threads = threads_wanted > 0 ? threads_wanted : omp_get_max_threads();
   const long n = static_cast<long>(source.size());
   std::vector<std::vector<double>> sums(static_cast<std::size_t>(threads), std::vector<double>(m, 0.0));
@@ -272,30 +250,41 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
     const std::size_t thread = static_cast<std::size_t>(omp_get_thread_num());
     std::vector<double> best(m);
     std::vector<char> found(m);
+    // The cells this point's shifts fell into so far, and their lists: nearby shifts share a cell.
+    std::vector<std::pair<std::uint64_t, CellNeighbours::List>> seen;
+    std::vector<std::uint32_t> scratch;
 #pragma omp for schedule(static) nowait
     for (long idx = 0; idx < n; ++idx) {
       const Vector3d xt = R * source[static_cast<std::size_t>(idx)].cast<double>() + t;
-      const Eigen::Vector3i c0 = ((xt + low) * inverse_resolution).array().floor().cast<int>();
-      const Eigen::Vector3i c1 = ((xt + high) * inverse_resolution).array().floor().cast<int>();
-      std::fill(found.begin(), found.end(), 0);
-      for (int x = c0.x(); x <= c1.x(); ++x)
-        for (int y = c0.y(); y <= c1.y(); ++y)
-          for (int z = c0.z(); z <= c1.z(); ++z) {
-            const Voxel* v = voxels.find(Eigen::Vector3i(x, y, z));
-            if (!v) continue;
-            for (std::size_t j = 0; j < m; ++j) {
-              const Vector3d q = xt + translations[j] - v->mean;
-              if (q.squaredNorm() > radius_sq) continue;
-              const double exponent = -0.5 * k.d2 * q.dot(v->inverse_covariance * q);
-              if (!found[j] || exponent > best[j]) best[j] = exponent;
-              found[j] = 1;
-            }
-          }
-      for (std::size_t j = 0; j < m; ++j)
+      seen.clear();
+      for (std::size_t j = 0; j < m; ++j) {
+        // Each shifted point looks at the voxels its own cell's list holds, as the score does: every
+        // voxel within reach is in it, so the largest exponent is the one of the whole neighbourhood.
+        const Vector3d shifted = xt + translations[j];
+        const Eigen::Vector3i cell = (shifted * inverse_resolution).array().floor().cast<int>();
+        const std::uint64_t key = VoxelLookup::pack(cell);
+        CellNeighbours::List list;
+        const auto at = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == key; });
+        if (at != seen.end()) {
+          list = at->second;
+        } else {
+          list = cells.get(cell, key, scratch);
+          if (list.size == 0 || list.voxels != scratch.data()) seen.emplace_back(key, list);  // a list not kept lasts one use
+        }
+        found[j] = 0;
+        for (std::uint32_t i = 0; i < list.size; ++i) {
+          const Voxel& v = voxels.voxels()[list.voxels[i]];
+          const Vector3d q = shifted - v.mean;
+          if (q.squaredNorm() > radius_sq) continue;
+          const double exponent = -0.5 * k.d2 * q.dot(v.inverse_covariance * q);
+          if (!found[j] || exponent > best[j]) best[j] = exponent;
+          found[j] = 1;
+        }
         if (found[j]) {
           sums[thread][j] += -k.d1 * std::exp(best[j]);
           ++counts[thread][j];
         }
+      }
     }
   }
   std::vector<double> nvtl(m, 0.0);

@@ -11,6 +11,7 @@
 
 #include "coloc/core/types.hpp"
 #include "coloc/ndt/ndt_config.hpp"
+#include "cell_neighbours.hpp"
 #include "voxel_index.hpp"
 #include "voxel_lookup.hpp"
 
@@ -39,26 +40,18 @@ struct ScoreEvaluation {
   std::size_t nvtl_points = 0; ///< points with at least one voxel in reach
 };
 
-/// What one alignment remembers between evaluations of the radius neighbourhood: per target cell that
-/// a source point fell into, the voxels of its 27-cell block whose means lie within one resolution of
-/// the cell (the only ones a point inside it can reach), in the order the 27-cell search visits them;
-/// and per point, its cell at the last evaluation. A point still in the same cell costs no hash probe,
-/// a point in a cell seen before costs one, and a new cell's list is gathered once for all the points
-/// in it (about ten of a dense scan's). The sums are the same bits as without the cache.
+/// What one alignment remembers between evaluations of the radius neighbourhood: per point, its cell at
+/// the last evaluation and that cell's voxels, the list the target's CellNeighbours keeps for every
+/// alignment against it. A point still in the same cell costs no lookup, a point in another cell one
+/// lookup in the shared lists (a cell no alignment has met yet: 27 hash probes, once). The sums are
+/// the same bits as without the cache.
 struct NeighbourCache {
-  NeighbourCache(std::size_t points, double resolution);
+  NeighbourCache(std::size_t points, const CellNeighbours& cells);
 
-  struct Lists {                            ///< one per thread: the cells its points fell into
-    PackedVoxelIndex cells;                 ///< packed cell -> list number
-    std::vector<std::uint32_t> begin{0};    ///< list n is voxels[begin[n], begin[n + 1])
-    std::vector<std::uint32_t> voxels;      ///< indices into VoxelLookup::voxels()
-  };
   static constexpr std::uint64_t kNoCell = ~0ULL;
-  double resolution_;
-  std::vector<std::uint64_t> cell_;  ///< per point: its packed cell at the last evaluation
-  std::vector<std::uint32_t> list_;  ///< per point: that cell's list in its thread's Lists
-  std::vector<int> thread_;          ///< per point: that thread
-  std::vector<Lists> lists_;
+  const CellNeighbours* cells_;
+  std::vector<std::uint64_t> cell_;              ///< per point: its packed cell at the last evaluation
+  std::vector<CellNeighbours::List> list_;       ///< per point: that cell's voxels
 };
 
 /// `cache` (radius neighbourhood only; else ignored): the alignment's memory of each point's voxels.
@@ -67,11 +60,11 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
                               NeighbourCache* cache = nullptr);
 
 /// NVTL of the source at `pose` shifted by each translation (map frame), over the radius
-/// neighbourhood: the same value per translation as evaluateScore's, in one walk over the voxels that
-/// any of the shifted points can reach.
+/// neighbourhood: the same value per translation as evaluateScore's. Each shifted point looks at its
+/// cell's list in `cells` (the target's, shared with the alignments).
 std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolution, const ScoreConstants& constants,
                                        const std::vector<Eigen::Vector3f>& source, const Vector6d& pose,
-                                       const std::vector<Eigen::Vector3d>& translations, int threads = 0);
+                                       const std::vector<Eigen::Vector3d>& translations, const CellNeighbours& cells, int threads = 0);
 
 /// Pose vector <-> homogeneous transform, in PCL's parametrisation.
 Eigen::Matrix4d poseToMatrix(const Vector6d& pose);

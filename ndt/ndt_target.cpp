@@ -74,6 +74,7 @@ NdtTarget::NdtTarget(const PointCloud& map, const NdtConfig& config) : impl_(std
   if (d.voxels.size() == 0)
     throw Error("NDT target: no voxel of " + std::to_string(config.resolution) +
                 " m holds the 6 points a covariance needs; the map is too sparse for this resolution");
+  d.neighbours = std::make_unique<CellNeighbours>(d.voxels, config.resolution);
 }
 
 NdtTarget::~NdtTarget() = default;

@@ -30,6 +30,8 @@ struct NdtTarget::Impl {
   /// The stock backend aligns with this object; its voxel grid also feeds `voxels`.
   std::shared_ptr<ExposedNdt> pcl_ndt;
   VoxelLookup voxels;
+  /// Each cell's reachable voxels, shared by every alignment against the target.
+  std::unique_ptr<CellNeighbours> neighbours;
 };
 
 PclCloud::Ptr toPcl(const PointCloud& cloud);

@@ -32,6 +32,15 @@ class DenseIndex {
     }
   }
   std::size_t size() const { return size_; }
+  static constexpr std::size_t kNone = ~std::size_t{0};
+  /// The index of `key`, kNone if it has none.
+  std::size_t find(const Key& key) const {
+    for (std::size_t i = Hash()(key) & mask_;; i = (i + 1) & mask_) {
+      const Slot& s = slots_[i];
+      if (s.index == kFree) return kNone;
+      if (s.key == key) return s.index;
+    }
+  }
 
  private:
   static constexpr std::uint32_t kFree = 0xFFFFFFFFu;  // more voxels than that do not fit in memory anyway

@@ -184,7 +184,7 @@ TEST(NvtlAtTranslations, EqualsTheScoreEvaluatedAtEachShiftedPose) {
   Vector6d pose;
   pose << 0.3, -0.2, 0.05, 0.01, -0.02, 0.4;
   const std::vector<Eigen::Vector3d> shifts = {{0, 0, 0}, {0.5, 0, 0}, {-1.0, 0.3, 0}, {0.2, -0.5, 0.1}, {-3.0, 2.5, 0}};
-  const std::vector<double> nvtl = nvtlAtTranslations(t.voxels, config.resolution, t.constants, scan.points, pose, shifts, 2);
+  const std::vector<double> nvtl = nvtlAtTranslations(t.voxels, config.resolution, t.constants, scan.points, pose, shifts, *t.neighbours, 2);
   ASSERT_EQ(nvtl.size(), shifts.size());
   for (std::size_t j = 0; j < shifts.size(); ++j) {
     Vector6d shifted = pose;

@@ -71,7 +71,8 @@ TEST(NdtScore, TheNeighbourCacheGivesTheSameBitsAsTheFullSearchWhereverThePoints
   const ScoreConstants k = scoreConstants(2.0, 0.55);
   ScoreOptions options;
   options.nvtl = true;
-  NeighbourCache cache(source.size(), 2.0);
+  const CellNeighbours cells(voxels, 2.0);
+  NeighbourCache cache(source.size(), cells);
   Vector6d pose = Vector6d::Zero();
   for (int step = 0; step < 40; ++step) {
     options.threads = 1 + step % 2;
