@@ -26,21 +26,33 @@ RecordedLog::RecordedLog(const std::string& path) {
   slots_ = std::make_unique<Slot[]>(messages_.size());
 }
 
-RecordedLog::RecordedLog(std::vector<io::TopicInfo> topics, std::vector<io::BagMessage> messages)
-    : topics_(std::move(topics)), messages_(std::move(messages)) {
+RecordedLog::RecordedLog(std::vector<io::TopicInfo> topics, std::vector<io::BagMessage> messages, std::vector<Scan> decoded)
+    : topics_(std::move(topics)) {
+  if (!decoded.empty() && decoded.size() != messages.size())
+    throw Error("recorded log: " + std::to_string(decoded.size()) + " decoded entries for " + std::to_string(messages.size()) + " messages");
   std::map<std::string, std::size_t> topic_at;
   for (std::size_t i = 0; i < topics_.size(); ++i) {
     topic_at[topics_[i].name] = i;
     topics_[i].message_count = 0;
   }
-  for (const io::BagMessage& m : messages_) {
+  for (const io::BagMessage& m : messages) {
     const auto t = topic_at.find(m.topic);
     if (t == topic_at.end()) throw Error("recorded log: a message on topic " + m.topic + ", which the log does not list");
     ++topics_[t->second].message_count;
   }
-  std::stable_sort(messages_.begin(), messages_.end(), [](const io::BagMessage& a, const io::BagMessage& b) { return a.log_time < b.log_time; });
+  std::vector<std::size_t> order(messages.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return messages[a].log_time < messages[b].log_time; });
+  messages_.reserve(messages.size());
+  for (std::size_t i : order) messages_.push_back(std::move(messages[i]));
   for (std::size_t i = 0; i < messages_.size(); ++i) messages_[i].index = i;
   slots_ = std::make_unique<Slot[]>(messages_.size());
+  for (std::size_t i = 0; i < order.size() && !decoded.empty(); ++i) {
+    Scan& given = decoded[order[i]];
+    if (!given.cloud) continue;
+    Slot& slot = slots_[i];
+    std::call_once(slot.once, [&] { slot.scan = std::move(given); });
+  }
 }
 
 RecordedLog::~RecordedLog() = default;

@@ -16,6 +16,7 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/tile_map.hpp"
+#include "coloc/pipeline/message_inputs.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/fix_consistency.hpp"
@@ -61,10 +62,25 @@ class LogRecorder {
     m.data = std::move(data);
     messages_.push_back(std::move(m));
   }
+  /// A scan: kept decoded (as a replay would decode it), serialised only for the file.
+  void writeScan(const std::string& topic, Stamp log_time, const io::PointCloud2& cloud) {
+    if (bag_) {
+      const io::Bytes data = io::encodePointCloud2(cloud);
+      bag_->write(topic, log_time, data.data(), data.size());
+    }
+    if (!keep_) return;
+    io::BagMessage m;
+    m.topic = topic;
+    m.log_time = log_time;
+    messages_.push_back(std::move(m));
+    decoded_.resize(messages_.size());
+    decoded_.back() = {cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud))};
+  }
   std::shared_ptr<const replay::RecordedLog> close() {
     if (bag_) bag_->close();
     if (!keep_) return nullptr;
-    return std::make_shared<const replay::RecordedLog>(std::move(topics_), std::move(messages_));
+    if (!decoded_.empty()) decoded_.resize(messages_.size());
+    return std::make_shared<const replay::RecordedLog>(std::move(topics_), std::move(messages_), std::move(decoded_));
   }
 
  private:
@@ -72,6 +88,7 @@ class LogRecorder {
   std::optional<io::BagWriter> bag_;
   std::vector<io::TopicInfo> topics_;
   std::vector<io::BagMessage> messages_;
+  std::vector<replay::RecordedLog::Scan> decoded_;  ///< per message so far; empty: none decoded
 };
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -358,7 +375,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
                            : sim::sweepPoints(roof, cast(), rng);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
-    bag.write("/points", at(t + 0.1) + 5'000'000, io::encodePointCloud2(toPointCloud2(sweep, at(t))));  // the sweep ends, the driver publishes
+    bag.writeScan("/points", at(t + 0.1) + 5'000'000, toPointCloud2(sweep, at(t)));  // the sweep ends, the driver publishes
     ++summary.scans;
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
     bool placed = false;

@@ -12,6 +12,7 @@
 #include "coloc/io/mcap_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
+#include "coloc/pipeline/message_inputs.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "real_data.hpp"
 #include "temp_dir.hpp"
@@ -284,6 +285,20 @@ TEST(LogReplay, ReplaysSharingACacheGiveTheSameResultsAsReplaysApart) {
   EXPECT_EQ(cache->targets()->stats().builds, 1u);
 }
 
+// The log at `file` and `in_memory` replayed against the real pair's map: the same fused poses and summary.
+void expectTheSameReplay(const std::string& file, const std::shared_ptr<const RecordedLog>& in_memory) {
+  ReplayOptions options;
+  options.map = testing::realData("hdl32e_pair/target.pcd");
+  options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
+  const ReplayResult read = replayLog(file, options);
+  options.cache = std::make_shared<ReplayCache>();
+  options.cache->add("drive in memory", in_memory);
+  const ReplayResult kept = replayLog("drive in memory", options);
+  ASSERT_EQ(kept.fused.size(), read.fused.size());
+  for (std::size_t k = 0; k < read.fused.size(); ++k) EXPECT_EQ(kept.fused[k].pose.position, read.fused[k].pose.position) << "tick " << k;
+  EXPECT_EQ(kept.summaryJson("log"), read.summaryJson("log"));
+}
+
 TEST(LogReplay, ALogMadeInMemoryIsTheLogAReaderGivesFromItsFileAndReplaysTheSame) {
   // Messages written out of time order (an RSU's fix arrives late): the log in memory puts them in the
   // order and numbering the rosbag2 reader gives, counts each topic, and replays as the file does.
@@ -321,16 +336,7 @@ TEST(LogReplay, ALogMadeInMemoryIsTheLogAReaderGivesFromItsFileAndReplaysTheSame
     EXPECT_EQ(in_memory->topics()[i].type, from_file.topics()[i].type);
     EXPECT_EQ(in_memory->topics()[i].message_count, from_file.topics()[i].message_count);
   }
-  ReplayOptions options;
-  options.map = testing::realData("hdl32e_pair/target.pcd");
-  options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n", "test.yaml");
-  const ReplayResult read = replayLog(dir / "scans", options);
-  options.cache = std::make_shared<ReplayCache>();
-  options.cache->add("drive in memory", in_memory);
-  const ReplayResult kept = replayLog("drive in memory", options);
-  ASSERT_EQ(kept.fused.size(), read.fused.size());
-  for (std::size_t k = 0; k < read.fused.size(); ++k) EXPECT_EQ(kept.fused[k].pose.position, read.fused[k].pose.position) << "tick " << k;
-  EXPECT_EQ(kept.summaryJson("log"), read.summaryJson("log"));
+  expectTheSameReplay(dir / "scans", in_memory);
 
   messages.front().topic = "/unlisted";
   try {
@@ -339,6 +345,44 @@ TEST(LogReplay, ALogMadeInMemoryIsTheLogAReaderGivesFromItsFileAndReplaysTheSame
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("/unlisted"), std::string::npos) << e.what();
   }
+}
+
+TEST(LogReplay, ALogGivenItsScansDecodedGivesEachToItsMessageAndReplaysAsItsFile) {
+  // A simulated drive keeps its scans decoded and their bytes empty: after the messages are put in log
+  // time order, each message must still have its own scan, and the replay must be the file's.
+  testing::TempDir dir;
+  const ndt::PointCloud scan = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
+  const Stamp t0 = 1'700'000'000'000'000'000LL;
+  const std::vector<io::TopicInfo> topics = {topicOf("/points", "sensor_msgs/msg/PointCloud2")};
+  std::vector<io::BagMessage> messages;
+  std::vector<RecordedLog::Scan> decoded;
+  {
+    io::BagWriter bag = io::BagWriter::create(dir / "scans");
+    bag.addTopic(topics[0]);
+    for (int i = 0; i < 3; ++i) {
+      const io::PointCloud2 cloud = toMessage(scan, t0 + i * 100'000'000LL);
+      io::BagMessage m;
+      m.topic = "/points";
+      m.log_time = t0 + (i == 1 ? 250'000'000LL : i * 100'000'000LL);  // the second written is logged last
+      const io::Bytes data = io::encodePointCloud2(cloud);
+      bag.write(m.topic, m.log_time, data.data(), data.size());
+      messages.push_back(m);
+      decoded.push_back({cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud))});
+    }
+    bag.close();
+  }
+  const RecordedLog from_file(dir / "scans");
+  auto given = std::make_shared<const RecordedLog>(topics, messages, decoded);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const RecordedLog::Scan a = given->scan(i, io::MessageKind::kPointCloud2), b = from_file.scan(i, io::MessageKind::kPointCloud2);
+    EXPECT_EQ(a.stamp, b.stamp) << "message " << i;
+    EXPECT_EQ(a.cloud->points, b.cloud->points) << "message " << i;
+    EXPECT_TRUE(given->messages()[i].data.empty());
+  }
+  expectTheSameReplay(dir / "scans", given);
+
+  decoded.pop_back();
+  EXPECT_THROW(RecordedLog(topics, messages, decoded), Error);  // not one per message
 }
 
 TEST(LogReplay, ScanTopicWithoutAMapIsListedAndSkipped) {

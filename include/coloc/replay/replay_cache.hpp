@@ -26,19 +26,22 @@ class RecordedLog {
  public:
   /// Throws coloc::Error as io::BagReader does for a log it cannot read.
   explicit RecordedLog(const std::string& path);
+  struct Scan {
+    Stamp stamp = 0;
+    std::shared_ptr<const ndt::PointCloud> cloud;
+  };
   /// A log made in memory (a simulated drive): `messages` in the order they were written, put in the
   /// order a rosbag2 reader gives them (by log time, then as written) and numbered; each topic's
   /// message_count counted. Throws coloc::Error for a message on a topic not in `topics`.
-  RecordedLog(std::vector<io::TopicInfo> topics, std::vector<io::BagMessage> messages);
+  /// `decoded` (empty, or one per message as written): a point cloud message given already decoded,
+  /// as scan() would decode it; its bytes may then be left empty (a drive made to be replayed at once
+  /// need not be serialised for it).
+  RecordedLog(std::vector<io::TopicInfo> topics, std::vector<io::BagMessage> messages, std::vector<Scan> decoded = {});
   ~RecordedLog();
 
   const std::vector<io::TopicInfo>& topics() const { return topics_; }
   const std::vector<io::BagMessage>& messages() const { return messages_; }
 
-  struct Scan {
-    Stamp stamp = 0;
-    std::shared_ptr<const ndt::PointCloud> cloud;
-  };
   /// Message i decoded as a point cloud (PointCloud2 as `kind`), on its first request only. Throws
   /// coloc::Error, every time it is asked, for a message that does not decode.
   Scan scan(std::size_t i, io::MessageKind kind) const;
