@@ -113,6 +113,12 @@ std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, con
 }
 
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng) {
+  std::vector<LidarPoint> points;
+  sweepPoints(spec, hits, rng, points);
+  return points;
+}
+
+void sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng, std::vector<LidarPoint>& points) {
   const int lasers = static_cast<int>(spec.vertical_deg.size());
   const int firings = firingsPerSweep(spec);
   if (hits.size() != static_cast<std::size_t>(firings * lasers))
@@ -123,7 +129,7 @@ std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<Ray
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const bool dropouts = spec.dropout > 0.0 || spec.dropout_at_max_range > 0.0;
-  std::vector<LidarPoint> points;
+  points.clear();
   points.reserve(hits.size());  // a sweep hits more than half its rays outdoors: no second allocation and copy
   for (int f = 0; f < firings; ++f) {
     const float time = static_cast<float>(sweep * f / firings);
@@ -140,7 +146,6 @@ std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<Ray
       points.push_back({static_cast<float>(range) * local[i], time, l, hits[i].mesh});
     }
   }
-  return points;
 }
 
 std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng) {

@@ -166,8 +166,9 @@ io::TopicInfo topic(const std::string& name, const std::string& type) {
   return t;
 }
 
-io::PointCloud2 toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp) {
-  io::PointCloud2 m;
+// The sweep as its driver publishes it, into `m` (kept between sweeps: a fresh 640 KB message per sweep
+// cost a zero fill and its page faults every time).
+void toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp, io::PointCloud2& m) {
   m.header = {stamp, "lidar"};
   m.height = 1;
   m.width = static_cast<std::uint32_t>(points.size());
@@ -181,7 +182,6 @@ io::PointCloud2 toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp 
     std::memcpy(&m.data[16 * i], points[i].position.data(), 12);
     std::memcpy(&m.data[16 * i + 12], &points[i].time, 4);
   }
-  return m;
 }
 
 Eigen::Isometry3d vehiclePose(const sim::VehicleState& s, double height) {
@@ -333,6 +333,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const sim::LidarSpec roof = sim::withErrors(sim::lidarNamed(scenario.vehicle_lidar), errors);
   const sim::OdometryNoise& odometry_noise = scenario.odometry;
   const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
+  // The roof sweep and its message, and an RSU's sweep, their room kept from sweep to sweep.
+  std::vector<sim::LidarPoint> sweep, rsu_sweep;
+  io::PointCloud2 roof_message;
   for (int k = 0; k <= ticks; ++k) {  // 100 Hz
     const double t = k * 0.01;
     const sim::VehicleState truth = drive.at(t);
@@ -370,12 +373,14 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       scene.place(capture, nullptr);
       return sim::castSweep(roof, scene.caster(), roof_pose);
     };
-    const auto sweep = options.roof_sweeps
-                           ? sim::sweepPoints(roof, *options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast), rng)
-                           : sim::sweepPoints(roof, cast(), rng);
+    if (options.roof_sweeps)
+      sim::sweepPoints(roof, *options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast), rng, sweep);
+    else
+      sim::sweepPoints(roof, cast(), rng, sweep);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
-    bag.writeScan("/points", at(t + 0.1) + 5'000'000, toPointCloud2(sweep, at(t)));  // the sweep ends, the driver publishes
+    toPointCloud2(sweep, at(t), roof_message);
+    bag.writeScan("/points", at(t + 0.1) + 5'000'000, roof_message);  // the sweep ends, the driver publishes
     ++summary.scans;
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
     bool placed = false;
@@ -404,7 +409,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
                                                     placeVehicle();
                                                     return sim::castSweep(r.lidar, with_vehicle.caster(), still);
                                                   });
-        frame = positionsOf(sim::sweepPoints(r.lidar, *hits, rng));
+        sim::sweepPoints(r.lidar, *hits, rng, rsu_sweep);
+        frame = positionsOf(rsu_sweep);
       } else {
         placeVehicle();
         frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);

@@ -55,6 +55,8 @@ std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, con
 /// ...and the points those hits give with the spec's noise and dropouts drawn from `rng` (two draws per
 /// ray, hit or not). Throws coloc::Error if `hits` is not a sweep of this spec.
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng);
+/// The same into `points` (its room kept: a loop over sweeps then allocates once).
+void sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng, std::vector<LidarPoint>& points);
 /// Firings in one revolution (360 deg / azimuth step).
 int firingsPerSweep(const LidarSpec& spec);
 
