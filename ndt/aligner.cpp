@@ -243,7 +243,7 @@ Matrix6d multiNdtScoreCovariance(const NdtTarget::Impl& t, const std::vector<Eig
     offsets.push_back(heading * Eigen::Vector2d(o[0], o[1]));
     shifts.emplace_back(offsets.back().x(), offsets.back().y(), 0.0);
   }
-  std::vector<double> scores = nvtlAtTranslations(t.voxels, config.resolution, t.constants, source, optimum, shifts, *t.neighbours, config.threads);
+  std::vector<double> scores = nvtlAtTranslations(t.voxels, config.resolution, t.constants, source, optimum, shifts, *t.neighbours, config.threads, cache);
   scores.insert(scores.begin(), nvtl);
   std::vector<double> w = weighted(scores);
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();

@@ -230,13 +230,14 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
 std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolution, const ScoreConstants& k,
                                        const std::vector<Eigen::Vector3f>& source, const Vector6d& pose,
                                        const std::vector<Eigen::Vector3d>& translations, const CellNeighbours& target_cells,
-                                       int threads_wanted) {
+                                       int threads_wanted, const NeighbourCache* cache) {
   const std::size_t m = translations.size();
   if (m == 0) return {};
   // The lists of a target built at another resolution do not describe this one's reach.
   std::unique_ptr<CellNeighbours> own;
   if (target_cells.resolution() != resolution) own = std::make_unique<CellNeighbours>(voxels, resolution);
   const CellNeighbours& cells = own ? *own : target_cells;
+  if (cache && (cache->cell_.size() != source.size() || cache->cells_ != &cells)) cache = nullptr;  // not this alignment's
   const Eigen::Matrix3d R = poseToMatrix(pose).topLeftCorner<3, 3>();
   const Vector3d t = pose.head<3>();
   const double inverse_resolution = 1.0 / resolution;
@@ -265,7 +266,9 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
         const std::uint64_t key = VoxelLookup::pack(cell);
         CellNeighbours::List list;
         const auto at = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == key; });
-        if (at != seen.end()) {
+        if (cache && cache->cell_[static_cast<std::size_t>(idx)] == key) {
+          list = cache->list_[static_cast<std::size_t>(idx)];  // still in the cell the alignment last saw the point in
+        } else if (at != seen.end()) {
           list = at->second;
         } else {
           list = cells.get(cell, key, scratch);

@@ -61,10 +61,12 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
 
 /// NVTL of the source at `pose` shifted by each translation (map frame), over the radius
 /// neighbourhood: the same value per translation as evaluateScore's. Each shifted point looks at its
-/// cell's list in `cells` (the target's, shared with the alignments).
+/// cell's list in `cells` (the target's, shared with the alignments), or in `cache` (the alignment's of
+/// these points) when the shift leaves the point in the cell the alignment last saw it in.
 std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolution, const ScoreConstants& constants,
                                        const std::vector<Eigen::Vector3f>& source, const Vector6d& pose,
-                                       const std::vector<Eigen::Vector3d>& translations, const CellNeighbours& cells, int threads = 0);
+                                       const std::vector<Eigen::Vector3d>& translations, const CellNeighbours& cells, int threads = 0,
+                                       const NeighbourCache* cache = nullptr);
 
 /// Pose vector <-> homogeneous transform, in PCL's parametrisation.
 Eigen::Matrix4d poseToMatrix(const Vector6d& pose);

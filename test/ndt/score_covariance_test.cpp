@@ -186,6 +186,10 @@ TEST(NvtlAtTranslations, EqualsTheScoreEvaluatedAtEachShiftedPose) {
   const std::vector<Eigen::Vector3d> shifts = {{0, 0, 0}, {0.5, 0, 0}, {-1.0, 0.3, 0}, {0.2, -0.5, 0.1}, {-3.0, 2.5, 0}};
   const std::vector<double> nvtl = nvtlAtTranslations(t.voxels, config.resolution, t.constants, scan.points, pose, shifts, *t.neighbours, 2);
   ASSERT_EQ(nvtl.size(), shifts.size());
+  // With the alignment's memory of each point's cell (filled by a score at the pose), the same bits.
+  NeighbourCache cache(scan.size(), *t.neighbours);
+  evaluateScore(t.voxels, config.resolution, t.constants, scan.points, pose, ScoreOptions{}, &cache);
+  EXPECT_EQ(nvtlAtTranslations(t.voxels, config.resolution, t.constants, scan.points, pose, shifts, *t.neighbours, 2, &cache), nvtl);
   for (std::size_t j = 0; j < shifts.size(); ++j) {
     Vector6d shifted = pose;
     shifted.head<3>() += shifts[j];
