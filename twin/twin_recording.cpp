@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,7 +17,6 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/tile_map.hpp"
-#include "coloc/pipeline/message_inputs.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/fix_consistency.hpp"
@@ -43,6 +43,43 @@ constexpr Stamp kEpoch = 1'700'000'000'000'000'000LL;  // the twin's clock start
 
 Stamp at(double t) { return kEpoch + fromSeconds(t); }
 
+// The sweep as its driver publishes it, into `m` (kept between sweeps: a fresh 640 KB message per sweep
+// cost a zero fill and its page faults every time).
+void toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp, io::PointCloud2& m) {
+  m.header = {stamp, "lidar"};
+  m.height = 1;
+  m.width = static_cast<std::uint32_t>(points.size());
+  m.fields = {{"x", 0, io::PointField::kFloat32, 1}, {"y", 4, io::PointField::kFloat32, 1}, {"z", 8, io::PointField::kFloat32, 1},
+              {"time", 12, io::PointField::kFloat32, 1}};
+  m.point_step = 16;
+  m.row_step = 16 * m.width;
+  m.is_dense = true;
+  m.data.resize(m.row_step);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::memcpy(&m.data[16 * i], points[i].position.data(), 12);
+    std::memcpy(&m.data[16 * i + 12], &points[i].time, 4);
+  }
+}
+
+// The sweep as the pipeline decodes toPointCloud2's message (pipeline::toPointCloud): its finite points,
+// each point's time in seconds after the earliest point's (the difference taken in double, as there),
+// without the message in between. Tested against the decoded file.
+ndt::PointCloud scanOf(const std::vector<sim::LidarPoint>& sweep) {
+  ndt::PointCloud cloud;
+  cloud.points.reserve(sweep.size());
+  double first = std::numeric_limits<double>::infinity();
+  for (const sim::LidarPoint& p : sweep) {
+    if (!p.position.allFinite()) continue;
+    cloud.points.push_back(p.position);
+    first = std::min(first, static_cast<double>(p.time));
+  }
+  if (cloud.points.empty()) return cloud;
+  cloud.times.reserve(cloud.points.size());
+  for (const sim::LidarPoint& p : sweep)
+    if (p.position.allFinite()) cloud.times.push_back(static_cast<float>(static_cast<double>(p.time) - first));
+  return cloud;
+}
+
 // The drive's log: written as rosbag2, kept in memory, or both.
 class LogRecorder {
  public:
@@ -62,10 +99,11 @@ class LogRecorder {
     m.data = std::move(data);
     messages_.push_back(std::move(m));
   }
-  /// A scan: kept decoded (as a replay would decode it), serialised only for the file.
-  void writeScan(const std::string& topic, Stamp log_time, const io::PointCloud2& cloud) {
+  /// A sweep stamped `stamp`: kept as a replay decodes its message, serialised only for the file.
+  void writeScan(const std::string& topic, Stamp log_time, const std::vector<sim::LidarPoint>& sweep, Stamp stamp) {
     if (bag_) {
-      const io::Bytes data = io::encodePointCloud2(cloud);
+      toPointCloud2(sweep, stamp, message_);
+      const io::Bytes data = io::encodePointCloud2(message_);
       bag_->write(topic, log_time, data.data(), data.size());
     }
     if (!keep_) return;
@@ -74,7 +112,7 @@ class LogRecorder {
     m.log_time = log_time;
     messages_.push_back(std::move(m));
     decoded_.resize(messages_.size());
-    decoded_.back() = {cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud))};
+    decoded_.back() = {stamp, std::make_shared<const ndt::PointCloud>(scanOf(sweep))};
   }
   std::shared_ptr<const replay::RecordedLog> close() {
     if (bag_) bag_->close();
@@ -89,6 +127,7 @@ class LogRecorder {
   std::vector<io::TopicInfo> topics_;
   std::vector<io::BagMessage> messages_;
   std::vector<replay::RecordedLog::Scan> decoded_;  ///< per message so far; empty: none decoded
+  io::PointCloud2 message_;  ///< a sweep's, its room kept from sweep to sweep (640 KB each)
 };
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -164,24 +203,6 @@ io::TopicInfo topic(const std::string& name, const std::string& type) {
   t.name = name;
   t.type = type;
   return t;
-}
-
-// The sweep as its driver publishes it, into `m` (kept between sweeps: a fresh 640 KB message per sweep
-// cost a zero fill and its page faults every time).
-void toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp, io::PointCloud2& m) {
-  m.header = {stamp, "lidar"};
-  m.height = 1;
-  m.width = static_cast<std::uint32_t>(points.size());
-  m.fields = {{"x", 0, io::PointField::kFloat32, 1}, {"y", 4, io::PointField::kFloat32, 1}, {"z", 8, io::PointField::kFloat32, 1},
-              {"time", 12, io::PointField::kFloat32, 1}};
-  m.point_step = 16;
-  m.row_step = 16 * m.width;
-  m.is_dense = true;
-  m.data.resize(m.row_step);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    std::memcpy(&m.data[16 * i], points[i].position.data(), 12);
-    std::memcpy(&m.data[16 * i + 12], &points[i].time, 4);
-  }
 }
 
 Eigen::Isometry3d vehiclePose(const sim::VehicleState& s, double height) {
@@ -333,9 +354,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const sim::LidarSpec roof = sim::withErrors(sim::lidarNamed(scenario.vehicle_lidar), errors);
   const sim::OdometryNoise& odometry_noise = scenario.odometry;
   const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
-  // The roof sweep and its message, and an RSU's sweep, their room kept from sweep to sweep.
+  // The roof sweep and an RSU's sweep, their room kept from sweep to sweep.
   std::vector<sim::LidarPoint> sweep, rsu_sweep;
-  io::PointCloud2 roof_message;
   for (int k = 0; k <= ticks; ++k) {  // 100 Hz
     const double t = k * 0.01;
     const sim::VehicleState truth = drive.at(t);
@@ -379,8 +399,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       sim::sweepPoints(roof, cast(), rng, sweep);
     summary.ray_casting_seconds += since(c0);
     summary.rays += raysPerSweep(roof);
-    toPointCloud2(sweep, at(t), roof_message);
-    bag.writeScan("/points", at(t + 0.1) + 5'000'000, roof_message);  // the sweep ends, the driver publishes
+    bag.writeScan("/points", at(t + 0.1) + 5'000'000, sweep, at(t));  // the sweep ends, the driver publishes
     ++summary.scans;
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
     bool placed = false;
