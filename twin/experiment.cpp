@@ -165,6 +165,7 @@ void runJob(Job& job) {
     replay::SmoothOptions so;
     so.replay = options;
     so.smoother = replay::smootherOptionsFor(job.config, job.calibrate);
+    so.smoother.threads = 1;  // as NDT's: the jobs run side by side instead (the same results, checked)
     so.calibrate_rsus = job.calibrate;
     replay::SmoothResult s = replay::smoothLog(job.log, so);
     if (job.calibrate && job.registry) {
