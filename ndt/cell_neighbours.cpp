@@ -24,8 +24,10 @@ void gatherCell(const VoxelLookup& voxels, double resolution, const Eigen::Vecto
 
 namespace {
 
-constexpr int kShardBits = 6;  // 64 shards: two threads seldom want the same lock
-constexpr std::size_t kBlock = 1 << 14;  // list storage comes in blocks of this many indices; a list fits in one
+// 16 shards: the threads of a vehicle or an experiment (two to eight) seldom want the same lock, and an
+// unused target costs little (each shard's table starts at 64 KB, its first block at 16 KB).
+constexpr int kShardBits = 4;
+constexpr std::size_t kBlock = 1 << 12;  // list storage comes in blocks of this many indices; a list (<= 27) fits in one
 
 }  // namespace
 
