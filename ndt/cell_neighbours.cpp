@@ -55,7 +55,7 @@ CellNeighbours::List CellNeighbours::get(const Eigen::Vector3i& cell, std::uint6
   if (s.lists.size() >= max_per_shard_) {  // this shard's share of the bound
     scratch.clear();
     gatherCell(voxels_, resolution_, cell, scratch);
-    return {scratch.data(), static_cast<std::uint32_t>(scratch.size())};
+    return {scratch.data(), static_cast<std::uint32_t>(scratch.size()), false};
   }
   s.index.insert(key);
   s.gathered.clear();
@@ -67,7 +67,7 @@ CellNeighbours::List CellNeighbours::get(const Eigen::Vector3i& cell, std::uint6
   std::uint32_t* stored = s.blocks.back().get() + s.used;
   std::copy(s.gathered.begin(), s.gathered.end(), stored);
   s.used += s.gathered.size();
-  s.lists.push_back({stored, static_cast<std::uint32_t>(s.gathered.size())});
+  s.lists.push_back({stored, static_cast<std::uint32_t>(s.gathered.size()), true});
   return s.lists.back();
 }
 

@@ -26,6 +26,7 @@ class CellNeighbours {
   struct List {
     const std::uint32_t* voxels = nullptr;  ///< indices into VoxelLookup::voxels()
     std::uint32_t size = 0;
+    bool kept = true;  ///< false: in the caller's scratch (the bound reached), good until its next use
   };
   static constexpr std::size_t kMaxCells = std::size_t{1} << 18;  ///< about 12 MB of lists at most
 
@@ -38,7 +39,7 @@ class CellNeighbours {
 
   double resolution() const { return resolution_; }
   /// `cell`'s list (`key`: VoxelLookup::pack(cell)). A list not kept (the bound reached) is gathered
-  /// into `scratch`, which then backs it until its next use.
+  /// into `scratch`, which then backs it until its next use (List::kept false).
   List get(const Eigen::Vector3i& cell, std::uint64_t key, std::vector<std::uint32_t>& scratch) const;
   std::size_t cells() const;  ///< lists kept
 

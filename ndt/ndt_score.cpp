@@ -5,8 +5,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <memory>
 #include <cmath>
+#include <memory>
 
 namespace coloc::ndt {
 
@@ -118,8 +118,7 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
     const std::uint64_t key = VoxelLookup::pack(cell);
     if (cache->cell_[i] != key) {
       const CellNeighbours::List list = cache->cells_->get(cell, key, scratch);
-      const bool kept = list.size == 0 || list.voxels != scratch.data();
-      cache->cell_[i] = kept ? key : NeighbourCache::kNoCell;
+      cache->cell_[i] = list.kept ? key : NeighbourCache::kNoCell;
       cache->list_[i] = list;
     }
     const CellNeighbours::List& list = cache->list_[i];
@@ -265,14 +264,13 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
         const Eigen::Vector3i cell = (shifted * inverse_resolution).array().floor().cast<int>();
         const std::uint64_t key = VoxelLookup::pack(cell);
         CellNeighbours::List list;
-        const auto at = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == key; });
         if (cache && cache->cell_[static_cast<std::size_t>(idx)] == key) {
           list = cache->list_[static_cast<std::size_t>(idx)];  // still in the cell the alignment last saw the point in
-        } else if (at != seen.end()) {
+        } else if (const auto at = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == key; }); at != seen.end()) {
           list = at->second;
         } else {
           list = cells.get(cell, key, scratch);
-          if (list.size == 0 || list.voxels != scratch.data()) seen.emplace_back(key, list);  // a list not kept lasts one use
+          if (list.kept) seen.emplace_back(key, list);  // a list not kept lasts one use
         }
         found[j] = 0;
         for (std::uint32_t i = 0; i < list.size; ++i) {
