@@ -17,7 +17,7 @@ namespace {
 // random phase, their wavelengths between `length` and four times it (each has variance 1/2).
 class SmoothError {
  public:
-  SmoothError(double sd, double length, std::mt19937_64& rng) : scale_(sd * std::sqrt(2.0 / kTerms)) {
+  SmoothError(double sd, double length, RandomEngine& rng) : scale_(sd * std::sqrt(2.0 / kTerms)) {
     std::uniform_real_distribution<double> wavelength(length, 4.0 * length), phase(0.0, 2.0 * M_PI);
     for (int k = 0; k < kTerms; ++k) terms_[k] = {2.0 * M_PI / wavelength(rng), phase(rng)};
   }
@@ -51,9 +51,9 @@ ndt::PointCloud surveyMap(const Scenario& scenario, const SurveyConfig& config, 
   lidar.range_noise = config.range_noise;
   lidar.max_range = config.max_range;
   const Route route(scenario.route_start, scenario.route_heading, scenario.route);
-  std::mt19937_64 rng(config.seed);
+  RandomEngine rng(config.seed);
   // The surveyor's pose error (ErrorSources::map_*): every scan is placed where the surveyor believed it was.
-  std::mt19937_64 error_rng(config.seed ^ nameHash(scenario.name));
+  RandomEngine error_rng(config.seed ^ nameHash(scenario.name));
   const ErrorSources& e = scenario.errors;
   const SmoothError error_x(e.map_position_sd, e.map_error_length, error_rng), error_y(e.map_position_sd, e.map_error_length, error_rng),
       error_yaw(e.map_yaw_sd, e.map_error_length, error_rng);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "coloc/core/error.hpp"
 
@@ -71,7 +72,7 @@ VehicleState Drive::at(double t) const {
   return v;
 }
 
-OdometrySample measureOdometry(const VehicleState& truth, const OdometryNoise& noise, std::mt19937_64& rng) {
+OdometrySample measureOdometry(const VehicleState& truth, const OdometryNoise& noise, RandomEngine& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
   const double a = n(rng), b = n(rng);  // always two draws: the sequence does not depend on the state
   return {truth.speed * noise.speed_scale + noise.speed_sigma * a, truth.yaw_rate + noise.yaw_rate_bias + noise.yaw_rate_sigma * b};

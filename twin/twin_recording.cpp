@@ -190,7 +190,7 @@ std::vector<Eigen::Vector3f> positionsOf(const std::vector<sim::LidarPoint>& poi
   return frame;
 }
 
-std::vector<Eigen::Vector3f> frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, std::mt19937_64& rng) {
+std::vector<Eigen::Vector3f> frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, sim::RandomEngine& rng) {
   return positionsOf(sim::scanSweep(spec, world, [&](double) { return pose; }, rng));
 }
 
@@ -292,8 +292,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const sim::VehicleBody& body = with_vehicle.egoBody();
   const sim::Route route(scenario.route_start, scenario.route_heading, scenario.route);
   const sim::Drive drive(route, scenario.speed);
-  std::mt19937_64 rng(scenario.seed);
-  std::mt19937_64 ideal_rng(scenario.seed + 17), stamp_rng(scenario.seed + 29);  // own streams: the main one unchanged by them
+  sim::RandomEngine rng(scenario.seed);
+  sim::RandomEngine ideal_rng(scenario.seed + 17), stamp_rng(scenario.seed + 29);  // own streams: the main one unchanged by them
   std::normal_distribution<double> stamp_jitter(0.0, 1.0);
 
   // 3. Roadside units: their background frames and perception.

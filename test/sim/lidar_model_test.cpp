@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <random>
 
 #include "coloc/sim/lidar_model.hpp"
 
@@ -17,7 +18,7 @@ int lowReturns(const LidarSpec& spec, double distance) {
   world.commit();
   LidarSpec quiet = spec;
   quiet.range_noise = 0.0;
-  std::mt19937_64 rng(1);
+  RandomEngine rng(1);
   const auto points = scanSweep(quiet, world, [](double) { return Eigen::Isometry3d(Eigen::Translation3d(0, 0, 2.0)); }, rng);
   int n = 0;
   for (const LidarPoint& p : points) {
@@ -50,7 +51,7 @@ TEST(LidarModel, SweepHasTheRightSizeTimesAndNoise) {
   RayCaster world;
   world.addMesh(groundRectangle({-200, -200}, {200, 200}));
   world.commit();
-  std::mt19937_64 rng(7);
+  RandomEngine rng(7);
   const LidarSpec spec = vlp16();
   const auto points = scanSweep(spec, world, [](double) { return Eigen::Isometry3d(Eigen::Translation3d(0, 0, 1.8)); }, rng);
   // Of the 8 downward beams, the 7 from -15 to -3 deg reach the ground within 100 m at every one of the
@@ -71,7 +72,7 @@ TEST(LidarModel, SameSeedSameScan) {
   RayCaster world;
   world.addMesh(box({10, 0, 0}, {2, 10, 5}));
   world.commit();
-  std::mt19937_64 a(3), b(3);
+  RandomEngine a(3), b(3);
   const auto still = [](double) { return Eigen::Isometry3d::Identity(); };
   const auto pa = scanSweep(vlp16(), world, still, a), pb = scanSweep(vlp16(), world, still, b);
   ASSERT_EQ(pa.size(), pb.size());
@@ -83,7 +84,7 @@ TEST(LidarModel, MovingSensorScanCarriesMotionDistortion) {
   RayCaster world;
   world.addMesh(box({30, 0, 0}, {1, 200, 10}));
   world.commit();
-  std::mt19937_64 rng(1);
+  RandomEngine rng(1);
   LidarSpec spec = vlp16();
   spec.range_noise = 0.0;
   const auto points = scanSweep(spec, world, [](double t) { return Eigen::Isometry3d(Eigen::Translation3d(20.0 * t, 0, 1)); }, rng);
@@ -108,7 +109,7 @@ RingScan ringScan(const LidarSpec& spec, float radius) {
   const auto still = [](double) { return Eigen::Isometry3d::Identity(); };
   LidarSpec exact = spec;
   exact.range_noise = exact.range_noise_per_m = exact.dropout = exact.dropout_at_max_range = 0.0;
-  std::mt19937_64 a(1), b(2);
+  RandomEngine a(1), b(2);
   const auto truth = scanSweep(exact, world, still, a), noisy = scanSweep(spec, world, still, b);
   std::map<std::pair<int, float>, float> range;
   for (const LidarPoint& p : truth) range[{p.laser, p.time}] = p.position.norm();
@@ -137,6 +138,56 @@ TEST(LidarModel, RangeNoiseAndLostReturnsGrowWithRangeAsConfigured) {
   EXPECT_EQ(ringScan(ideal, 80.0f).lost, 0.0);
   EXPECT_NEAR(ringScan(ideal, 80.0f).noise_sd, 0.02, 0.001);
 }
+
+#if defined(__GLIBCXX__)
+// The twin's results were made with libstdc++'s std::normal_distribution and uniform draws, two per ray
+// in ray order, hit or not; the sweep's own draws (whose log is skipped for rays that return nothing)
+// must give every point the very range those gave.
+TEST(LidarModel, SweepNoiseIsTheStandardDrawsPerRayWhateverTheRaysHit) {
+  LidarSpec spec = vlp32c();
+  spec.range_noise = 0.02;
+  spec.range_noise_per_m = 0.0005;
+  spec.dropout = 0.05;
+  spec.dropout_at_max_range = 0.3;
+  const std::size_t rays = static_cast<std::size_t>(firingsPerSweep(spec)) * spec.vertical_deg.size();
+  // Hits and misses in runs and alone, so that pairs of draws fall on two misses, two hits and one of each.
+  std::mt19937 pattern(5);
+  std::uniform_real_distribution<float> distance(0.5f, 110.0f);
+  std::vector<RayHit> hits(rays);
+  for (std::size_t i = 0; i < rays; ++i)
+    if ((i / 7) % 3 != 0 && pattern() % 5 != 0) hits[i] = {distance(pattern), static_cast<int>(i % 4)};
+  // The reference: the standard distributions on std::mt19937_64, each kept point's range written back
+  // as a hit, which a sweep without noise or dropouts turns into the same point.
+  std::mt19937_64 reference(99);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<RayHit> kept(rays);
+  for (std::size_t i = 0; i < rays; ++i) {
+    const double n = noise(reference), u = uniform(reference);
+    if (hits[i].distance < 0.0f) continue;
+    const double r = hits[i].distance;
+    if (u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
+    const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
+    if (range < spec.min_range || range > spec.max_range) continue;
+    kept[i] = {static_cast<float>(range), hits[i].mesh};
+  }
+  LidarSpec exact = spec;
+  exact.range_noise = exact.range_noise_per_m = exact.dropout = exact.dropout_at_max_range = 0.0;
+  exact.min_range = 0.0;
+  RandomEngine engine(99), unused(1);
+  const std::vector<LidarPoint> noisy = sweepPoints(spec, hits, engine), expected = sweepPoints(exact, kept, unused);
+  ASSERT_EQ(noisy.size(), expected.size());
+  ASSERT_GT(noisy.size(), rays / 3);
+  for (std::size_t i = 0; i < noisy.size(); ++i) {
+    ASSERT_EQ(noisy[i].position, expected[i].position) << "point " << i;
+    ASSERT_EQ(noisy[i].time, expected[i].time);
+    ASSERT_EQ(noisy[i].laser, expected[i].laser);
+    ASSERT_EQ(noisy[i].mesh, expected[i].mesh);
+  }
+  // And the sweep took exactly the draws the reference took.
+  EXPECT_EQ(engine(), reference());
+}
+#endif
 
 }  // namespace
 }  // namespace coloc::sim

@@ -29,7 +29,7 @@ std::map<std::pair<bool, bool>, double> meanErrors(const LidarSpec& spec, const 
   mount.position = {0.0, -6.0, 2.0};
   const auto sensor = [&](double) { return Eigen::Isometry3d(Eigen::Translation3d(mount.position)); };
   LidarSpec quiet = spec;
-  std::mt19937_64 rng(9);
+  RandomEngine rng(9);
   std::vector<Eigen::Vector3f> reference;
   for (const LidarPoint& p : scanSweep(quiet, world, sensor, rng)) reference.push_back(p.position);
   std::map<std::pair<bool, bool>, double> sum;
@@ -75,7 +75,7 @@ TEST(RoadsidePerception, NoVehicleInViewIsNotFound) {
   RayCaster world;
   world.addMesh(groundRectangle({-50, -50}, {50, 50}));
   world.commit();
-  std::mt19937_64 rng(1);
+  RandomEngine rng(1);
   std::vector<Eigen::Vector3f> frame;
   for (const LidarPoint& p : scanSweep(vlp16(), world, [](double) { return Eigen::Isometry3d(Eigen::Translation3d(0, 0, 2)); }, rng))
     frame.push_back(p.position);
@@ -99,7 +99,7 @@ class Neighbours : public ::testing::Test {
     reference_ = frame();
   }
   std::vector<Eigen::Vector3f> frame() {
-    std::mt19937_64 rng(11);
+    RandomEngine rng(11);
     std::vector<Eigen::Vector3f> f;
     for (const LidarPoint& p : scanSweep(vlp32c(), world_, [&](double) { return Eigen::Isometry3d(Eigen::Translation3d(mount_.position)); }, rng))
       f.push_back(p.position);

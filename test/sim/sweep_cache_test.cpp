@@ -21,7 +21,7 @@ TEST(SweepCache, ASecondDriveGetsTheSamePointsWithoutCastingAndAnotherPathIsCast
   };
   SweepCache cache;
   for (std::uint64_t seed : {1u, 2u}) {
-    std::mt19937_64 uncached(seed), cached(seed);
+    RandomEngine uncached(seed), cached(seed);
     const auto plain = scanSweep(spec, world, path(10.0), uncached);
     const auto hits = cache.get(0, sweepFingerprint(spec, path(10.0)), [&] { return castSweep(spec, world, path(10.0)); });
     const auto shared = sweepPoints(spec, *hits, cached);
@@ -51,7 +51,7 @@ TEST(SweepCache, HitsOfAnotherLidarAreRefusedWithAnErrorNamingIt) {
   world.addMesh(box({10, 0, 0}, {2, 10, 5}));
   world.commit();
   const auto hits = castSweep(vlp16(), world, [](double) { return Eigen::Isometry3d::Identity(); });
-  std::mt19937_64 rng(1);
+  RandomEngine rng(1);
   try {
     sweepPoints(vlp32c(), hits, rng);
     FAIL() << "expected an error";

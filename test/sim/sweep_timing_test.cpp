@@ -74,7 +74,7 @@ class SweepTiming : public ::testing::Test {
     double t0 = 0.0;
     while (drive.at(t0).position.x() < 70.0) t0 += 0.001;
     EXPECT_NEAR(drive.at(t0).speed, speed, 1e-9) << "the sweep must be taken at cruise";
-    std::mt19937_64 rng(11);
+    RandomEngine rng(11);
     const auto sweep = scanSweep(vlp32c(), *world_, [&](double dt) { return lidarPose(drive.at(t0 + dt)); }, rng);
     ndt::PointCloud cloud;
     for (const LidarPoint& p : sweep) {

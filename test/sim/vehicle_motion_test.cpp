@@ -40,7 +40,7 @@ TEST(Drive, ShortRouteRampsUpAndDownWithoutCruising) {
 }
 
 TEST(Odometry, NoiseAndBiasHaveTheConfiguredSize) {
-  std::mt19937_64 rng(2);
+  RandomEngine rng(2);
   VehicleState truth;
   truth.speed = 10.0;
   truth.yaw_rate = 0.1;

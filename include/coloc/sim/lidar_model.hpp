@@ -5,10 +5,10 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
-#include <random>
 #include <string>
 #include <vector>
 
+#include "coloc/sim/random_engine.hpp"
 #include "coloc/sim/ray_caster.hpp"
 
 namespace coloc::sim {
@@ -48,15 +48,15 @@ using SensorTrajectory = std::function<Eigen::Isometry3d(double t)>;
 
 /// One revolution. Each firing is cast from where the sensor is at its own time, so a moving sensor's
 /// scan carries the motion distortion a real one has. Noise is drawn from `rng`.
-std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::mt19937_64& rng);
+std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, RandomEngine& rng);
 
 /// scanSweep in its two halves. The geometry: every ray's hit, firing-major, lasers in spec order...
 std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose);
 /// ...and the points those hits give with the spec's noise and dropouts drawn from `rng` (two draws per
 /// ray, hit or not). Throws coloc::Error if `hits` is not a sweep of this spec.
-std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng);
+std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng);
 /// The same into `points` (its room kept: a loop over sweeps then allocates once).
-void sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, std::mt19937_64& rng, std::vector<LidarPoint>& points);
+void sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng, std::vector<LidarPoint>& points);
 /// Firings in one revolution (360 deg / azimuth step).
 int firingsPerSweep(const LidarSpec& spec);
 

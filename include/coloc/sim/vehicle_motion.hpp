@@ -4,8 +4,9 @@
 // known at any time. Its sensors: wheel speed and yaw rate with noise and bias.
 #include <Eigen/Geometry>
 #include <cstdint>
-#include <random>
 #include <vector>
+
+#include "coloc/sim/random_engine.hpp"
 
 namespace coloc::sim {
 
@@ -72,6 +73,6 @@ struct OdometrySample {
 };
 
 /// Noisy wheel speed and gyro readings of a true state; draws from `rng`.
-OdometrySample measureOdometry(const VehicleState& truth, const OdometryNoise& noise, std::mt19937_64& rng);
+OdometrySample measureOdometry(const VehicleState& truth, const OdometryNoise& noise, RandomEngine& rng);
 
 }  // namespace coloc::sim
