@@ -78,17 +78,6 @@ struct VoxelSum {
   int count = 0;
 };
 
-// floor(v) as an integer voxel coordinate, false for a value that is not finite or whose voxel is
-// beyond 2e9 (integer arithmetic: floor() has no instruction on the baseline x86-64 this is built for).
-inline bool voxelCoordinate(double v, std::int32_t& out) {
-  if (!(std::abs(v) < 4e9)) return false;
-  std::int64_t k = static_cast<std::int64_t>(v);  // toward zero
-  if (static_cast<double>(k) > v) --k;
-  if (!(std::abs(static_cast<double>(k)) < 2e9)) return false;
-  out = static_cast<std::int32_t>(k);
-  return true;
-}
-
 // One point per occupied voxel, the centroid of the points `pointAt(i, point, time)` gives for
 // i = 0 .. count - 1 (false: no point), in order of first appearance.
 // Voxel -> its sum, by direct lookup for the voxels within kReach of the sensor's horizontally and
@@ -156,7 +145,7 @@ PointCloud voxelCentroids(std::size_t count, bool times, double voxel_size, Poin
     const double x = point.x(), y = point.y(), z = point.z();
     // A point that is not finite, or too far out for integer voxel coordinates, has no voxel.
     VoxelCoordinates key;
-    if (!voxelCoordinate(x * inverse, key.x) || !voxelCoordinate(y * inverse, key.y) || !voxelCoordinate(z * inverse, key.z)) continue;
+    if (!voxelOf(x, y, z, inverse, key)) continue;
     // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
     if (!(have_last && key == last_key)) {
       bool inserted = false;

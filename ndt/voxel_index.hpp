@@ -4,6 +4,7 @@
 // touches a table that stays in cache (a cloud has far fewer voxels than points). Used wherever points
 // are binned by voxel.
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -73,11 +74,26 @@ inline std::uint64_t mixBits(std::uint64_t h) {
   return h;
 }
 
+// floor(v) as an integer voxel coordinate, false for a value that is not finite or whose voxel is
+// beyond 2e9 (integer arithmetic: floor() has no instruction on the baseline x86-64 this is built for).
+inline bool voxelCoordinate(double v, std::int32_t& out) {
+  if (!(std::abs(v) < 4e9)) return false;
+  std::int64_t k = static_cast<std::int64_t>(v);  // toward zero
+  if (static_cast<double>(k) > v) --k;
+  if (!(std::abs(static_cast<double>(k)) < 2e9)) return false;
+  out = static_cast<std::int32_t>(k);
+  return true;
+}
+
 /// Integer voxel coordinates over the whole int32 range.
 struct VoxelCoordinates {
   std::int32_t x = 0, y = 0, z = 0;
   bool operator==(const VoxelCoordinates& o) const { return x == o.x && y == o.y && z == o.z; }
 };
+/// The voxel of (x, y, z) with voxels 1 / `inverse` wide; false for a point that has none.
+inline bool voxelOf(double x, double y, double z, double inverse, VoxelCoordinates& key) {
+  return voxelCoordinate(x * inverse, key.x) && voxelCoordinate(y * inverse, key.y) && voxelCoordinate(z * inverse, key.z);
+}
 struct VoxelCoordinatesHash {
   std::size_t operator()(const VoxelCoordinates& c) const {
     return static_cast<std::size_t>(mixBits(static_cast<std::uint32_t>(c.x) * 0x9E3779B97F4A7C15ULL ^

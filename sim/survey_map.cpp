@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "coloc/ndt/preprocess.hpp"
+#include "coloc/ndt/voxel_thinning.hpp"
 #include "coloc/sim/lidar_model.hpp"
 
 namespace coloc::sim {
@@ -57,7 +57,7 @@ ndt::PointCloud surveyMap(const Scenario& scenario, const SurveyConfig& config, 
   const ErrorSources& e = scenario.errors;
   const SmoothError error_x(e.map_position_sd, e.map_error_length, error_rng), error_y(e.map_position_sd, e.map_error_length, error_rng),
       error_yaw(e.map_yaw_sd, e.map_error_length, error_rng);
-  ndt::PointCloud merged;
+  ndt::VoxelThinning merged(config.voxel);
   const int stops = std::max(1, static_cast<int>(std::floor(route.length() / config.spacing)) + 1);
   for (int i = 0; i < stops; ++i) {
     Eigen::Vector2d xy;
@@ -68,12 +68,13 @@ ndt::PointCloud surveyMap(const Scenario& scenario, const SurveyConfig& config, 
     const Eigen::Isometry3d believed = Eigen::Translation3d(xy.x() + error_x(s), xy.y() + error_y(s), config.lidar_height) *
                                        Eigen::AngleAxisd(yaw + error_yaw(s), Eigen::Vector3d::UnitZ());
     for (const LidarPoint& p : scanSweep(lidar, world, [&](double) { return pose; }, rng))
-      merged.points.push_back((believed * p.position.cast<double>()).cast<float>());
+      merged.add((believed * p.position.cast<double>()).cast<float>());
     // Thin as we go, so that memory follows the map's surface, not the number of scans.
-    if (i % 10 == 9) merged = ndt::voxelDownsample(merged, config.voxel);
+    if (i % 10 == 9) merged.thin();
     if (progress) progress(static_cast<double>(i + 1) / stops);
   }
-  return ndt::voxelDownsample(merged, config.voxel);
+  merged.thin();
+  return merged.release();
 }
 
 }  // namespace coloc::sim
