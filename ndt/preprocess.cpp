@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 
+#include "scan_stage.hpp"
 #include "voxel_index.hpp"
 
 namespace coloc::ndt {
@@ -36,8 +38,24 @@ PointCloud cropRange(const PointCloud& cloud, double min_range, double max_range
 namespace {
 
 // The sensor's motion over a sweep, for moving a point into the frame at time 0: where the sensor was
-// at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0). The lasers of one firing
-// share its time, so the motion is recomputed only when the time changes.
+// at time t, seen from time 0, moving on a circular arc (a line if wz ~ 0).
+RunMotion motionAt(double vx, double wz, double t) {
+  RunMotion m;
+  m.moves = true;
+  const double angle = wz * t;
+  if (std::abs(wz) < 1e-9) {
+    m.dx = vx * t;
+    m.dy = 0.0;
+  } else {
+    m.dx = vx * std::sin(angle) / wz;
+    m.dy = vx * (1.0 - std::cos(angle)) / wz;
+  }
+  m.c = std::cos(angle);
+  m.s = std::sin(angle);
+  return m;
+}
+
+// The lasers of one firing share its time, so the motion is recomputed only when the time changes.
 class Deskew {
  public:
   Deskew(double vx, double wz) : vx_(vx), wz_(wz) {}
@@ -45,23 +63,15 @@ class Deskew {
     const double t = time;
     if (!(t == last_t_)) {
       last_t_ = t;
-      const double angle = wz_ * t;
-      if (std::abs(wz_) < 1e-9) {
-        dx_ = vx_ * t;
-        dy_ = 0.0;
-      } else {
-        dx_ = vx_ * std::sin(angle) / wz_;
-        dy_ = vx_ * (1.0 - std::cos(angle)) / wz_;
-      }
-      c_ = std::cos(angle);
-      s_ = std::sin(angle);
+      m_ = motionAt(vx_, wz_, t);
     }
-    return Eigen::Vector3f(static_cast<float>(c_ * p.x() - s_ * p.y() + dx_), static_cast<float>(s_ * p.x() + c_ * p.y() + dy_), p.z());
+    return Eigen::Vector3f(static_cast<float>(m_.c * p.x() - m_.s * p.y() + m_.dx), static_cast<float>(m_.s * p.x() + m_.c * p.y() + m_.dy), p.z());
   }
 
  private:
   double vx_, wz_;
-  double last_t_ = std::nan(""), dx_ = 0.0, dy_ = 0.0, c_ = 1.0, s_ = 0.0;
+  double last_t_ = std::nan("");
+  RunMotion m_;
 };
 
 void deskewInPlace(PointCloud& cloud, double vx, double wz) {
@@ -126,41 +136,51 @@ class VoxelSlots {
   std::vector<std::size_t> far_sums_;
 };
 
-template <typename PointAt>
-PointCloud voxelCentroids(std::size_t count, bool times, double voxel_size, PointAt&& pointAt) {
-  thread_local VoxelSlots slots;
+// One point per occupied voxel, the centroid of the cloud's points as staged (cropped, moved) in runs:
+// `runAt(i, motion)` gives the motion of the run that starts at point i and returns where it ends.
+// `zero_times`: the points' times are 0 after the motion (deskewed), else their own.
+template <typename RunAt>
+PointCloud voxelCentroids(const PointCloud& cloud, const StageBounds& bounds, bool zero_times, RunAt&& runAt) {
+  // The thread's tables, kept between scans; bound once (a thread-local's address is a library call away).
+  thread_local VoxelSlots thread_slots;
+  constexpr std::size_t kBlock = 256;  // staged at a time: stays in the first-level cache
+  thread_local std::vector<StagedPoint> thread_staged(kBlock);
+  VoxelSlots& slots = thread_slots;
+  StagedPoint* const staged = thread_staged.data();
   struct Clear {
     VoxelSlots& s;
     ~Clear() { s.clear(); }
   } clear_after{slots};
+  const bool times = cloud.hasTimes();
   std::vector<VoxelSum> sums;
-  const double inverse = 1.0 / voxel_size;
   VoxelCoordinates last_key;
   std::size_t last_at = 0;
   bool have_last = false;
-  Eigen::Vector3f point;
-  float time = 0.0f;
-  for (std::size_t i = 0; i < count; ++i) {
-    if (!pointAt(i, point, time)) continue;
-    const double x = point.x(), y = point.y(), z = point.z();
-    // A point that is not finite, or too far out for integer voxel coordinates, has no voxel.
-    VoxelCoordinates key;
-    if (!voxelOf(x, y, z, inverse, key)) continue;
-    // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
-    if (!(have_last && key == last_key)) {
-      bool inserted = false;
-      const std::size_t at = slots.find(key, sums.size(), inserted);
-      if (inserted) sums.emplace_back();
-      last_key = key;
-      last_at = at;
-      have_last = true;
+  for (std::size_t i = 0; i < cloud.size();) {
+    RunMotion motion;
+    const std::size_t end = std::min(runAt(i, motion), i + kBlock);
+    stageRun(cloud.points.data() + i, end - i, motion, bounds, staged);
+    for (std::size_t j = i; j < end; ++j) {
+      const StagedPoint& p = staged[j - i];
+      // A point cropped, not finite, or too far out for integer voxel coordinates has no voxel.
+      if (!p.ok) continue;
+      // Neighbours in a scan's order (lasers of one firing, successive firings) often share a voxel.
+      if (!(have_last && p.key == last_key)) {
+        bool inserted = false;
+        const std::size_t at = slots.find(p.key, sums.size(), inserted);
+        if (inserted) sums.emplace_back();
+        last_key = p.key;
+        last_at = at;
+        have_last = true;
+      }
+      VoxelSum& s = sums[last_at];
+      s.x += p.p.x();
+      s.y += p.p.y();
+      s.z += p.p.z();
+      if (times) s.time += zero_times ? 0.0f : cloud.times[j];
+      ++s.count;
     }
-    VoxelSum& s = sums[last_at];
-    s.x += x;
-    s.y += y;
-    s.z += z;
-    if (times) s.time += time;
-    ++s.count;
+    i = end;
   }
   PointCloud out;
   out.points.reserve(sums.size());
@@ -182,12 +202,10 @@ PointCloud deskew(const PointCloud& cloud, double vx, double wz) {
 
 PointCloud voxelDownsample(const PointCloud& cloud, double voxel_size) {
   if (!(voxel_size > 0.0)) return cloud;
-  const bool times = cloud.hasTimes();
-  return voxelCentroids(cloud.size(), times, voxel_size, [&](std::size_t i, Eigen::Vector3f& p, float& t) {
-    p = cloud.points[i];
-    if (times) t = cloud.times[i];
-    return true;
-  });
+  StageBounds everything;  // no crop: no squared range is below 0 or above infinity
+  everything.hi = std::numeric_limits<double>::infinity();
+  everything.inverse = 1.0 / voxel_size;
+  return voxelCentroids(cloud, everything, false, [&](std::size_t, RunMotion&) { return cloud.size(); });
 }
 
 PointCloud capPoints(const PointCloud& cloud, std::size_t max_points, std::uint32_t seed) {
@@ -219,21 +237,19 @@ PointCloud preprocessScan(const PointCloud& scan, const PreprocessConfig& config
   }
   // Crop, deskew and downsample in one pass over the scan, without the cropped copy in between: the
   // same points in the same order as the three steps one after the other, so the same bytes.
-  const bool times = scan.hasTimes();
-  const bool moving = config.deskew && times;
-  const double lo = config.min_range * config.min_range, hi = config.max_range * config.max_range;
-  Deskew move(vx, wz);
-  const PointCloud cloud = voxelCentroids(scan.size(), times, config.voxel_size, [&](std::size_t i, Eigen::Vector3f& p, float& t) {
-    const double r = squaredRange(scan.points[i]);
-    if (r < lo || r > hi) return false;
-    if (moving) {
-      p = move(scan.points[i], scan.times[i]);
-      t = 0.0f;
-    } else {
-      p = scan.points[i];
-      if (times) t = scan.times[i];
-    }
-    return true;
+  const bool moving = config.deskew && scan.hasTimes();
+  StageBounds bounds;
+  bounds.lo = config.min_range * config.min_range;
+  bounds.hi = config.max_range * config.max_range;
+  bounds.inverse = 1.0 / config.voxel_size;
+  // Runs of one time (the lasers of a firing) share their motion.
+  const PointCloud cloud = voxelCentroids(scan, bounds, moving, [&](std::size_t i, RunMotion& motion) {
+    if (!moving) return scan.size();
+    const float t = scan.times[i];
+    std::size_t end = i + 1;
+    while (end < scan.size() && scan.times[end] == t) ++end;
+    motion = motionAt(vx, wz, t);
+    return end;
   });
   return capPoints(cloud, config.max_points, config.seed);
 }
