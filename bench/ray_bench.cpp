@@ -1,10 +1,14 @@
 // Ray casting of the twin: rays per second of RayCaster::cast (packets of 8 on every core) against
 // castOneByOne (one ray at a time on one thread, the reference), in the same run, on a street of
-// houses, trees and cars seen by a 32-beam LiDAR sweep (57,600 rays).
+// houses, trees and cars seen by a 32-beam LiDAR sweep (57,600 rays). And the sweep's noise: the points
+// sim::sweepPoints makes of those hits (range noise and dropouts, two draws per ray) against the same
+// loop on the standard library's engine and distributions, which give the same draws (one thread).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <random>
 
+#include "coloc/sim/lidar_model.hpp"
 #include "coloc/sim/ray_caster.hpp"
 #include "street_scene.hpp"
 
@@ -16,7 +20,11 @@ using coloc::sim::RayHit;
 struct Street {
   RayCaster world;
   std::vector<Eigen::Vector3f> origins, directions;
-  Street() { coloc::testing::buildStreet(world, origins, directions); }
+  std::vector<RayHit> hits;
+  Street() {
+    coloc::testing::buildStreet(world, origins, directions);
+    world.cast(origins, directions, 120.0f, hits);
+  }
 };
 
 Street& street() {
@@ -36,8 +44,56 @@ void BM_CastPackets(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * street().origins.size()));
 }
 
+// A VLP-32C with range-dependent noise and dropouts (its sweep is the street's 57,600 rays).
+coloc::sim::LidarSpec noisySpec() {
+  coloc::sim::LidarSpec spec = coloc::sim::vlp32c();
+  spec.range_noise_per_m = 0.0002;
+  spec.dropout = 0.01;
+  spec.dropout_at_max_range = 0.2;
+  return spec;
+}
+
+// The reference: per ray a std::normal_distribution and a std::uniform_real_distribution draw on
+// std::mt19937_64, the point kept as sweepPoints keeps it.
+void BM_SweepNoiseStandardLibrary(benchmark::State& state) {
+  const coloc::sim::LidarSpec spec = noisySpec();
+  const std::vector<RayHit>& hits = street().hits;
+  const std::vector<Eigen::Vector3f>& directions = street().directions;
+  std::mt19937_64 rng(1);
+  std::vector<coloc::sim::LidarPoint> points;
+  for (auto _ : state) {
+    std::normal_distribution<double> noise(0.0, 1.0);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    points.clear();
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+      const double n = noise(rng), u = uniform(rng);
+      if (hits[i].distance < 0.0f) continue;
+      const double r = hits[i].distance;
+      if (u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
+      const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
+      if (range < spec.min_range || range > spec.max_range) continue;
+      points.push_back({static_cast<float>(range) * directions[i], 0.0f, static_cast<int>(i % 32), hits[i].mesh});
+    }
+    benchmark::DoNotOptimize(points.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * hits.size()));
+}
+
+void BM_SweepNoise(benchmark::State& state) {
+  const coloc::sim::LidarSpec spec = noisySpec();
+  coloc::sim::RandomEngine rng(1);
+  std::vector<coloc::sim::LidarPoint> points;
+  for (auto _ : state) {
+    coloc::sim::sweepPoints(spec, street().hits, rng, points);
+    benchmark::DoNotOptimize(points.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * street().hits.size()));
+}
+
 BENCHMARK(BM_CastOneByOne)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_CastPackets)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_SweepNoiseStandardLibrary)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_SweepNoise)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
 }  // namespace
 
