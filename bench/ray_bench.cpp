@@ -6,10 +6,10 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <random>
 
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/sim/ray_caster.hpp"
+#include "standard_sweep.hpp"
 #include "street_scene.hpp"
 
 namespace {
@@ -54,29 +54,16 @@ coloc::sim::LidarSpec noisySpec() {
 }
 
 // The reference: per ray a std::normal_distribution and a std::uniform_real_distribution draw on
-// std::mt19937_64, the point kept as sweepPoints keeps it.
+// std::mt19937_64 (each ray's noisy range kept as a hit: the same work less the points' directions).
 void BM_SweepNoiseStandardLibrary(benchmark::State& state) {
   const coloc::sim::LidarSpec spec = noisySpec();
-  const std::vector<RayHit>& hits = street().hits;
-  const std::vector<Eigen::Vector3f>& directions = street().directions;
   std::mt19937_64 rng(1);
-  std::vector<coloc::sim::LidarPoint> points;
+  std::vector<RayHit> kept;
   for (auto _ : state) {
-    std::normal_distribution<double> noise(0.0, 1.0);
-    std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    points.clear();
-    for (std::size_t i = 0; i < hits.size(); ++i) {
-      const double n = noise(rng), u = uniform(rng);
-      if (hits[i].distance < 0.0f) continue;
-      const double r = hits[i].distance;
-      if (u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
-      const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
-      if (range < spec.min_range || range > spec.max_range) continue;
-      points.push_back({static_cast<float>(range) * directions[i], 0.0f, static_cast<int>(i % 32), hits[i].mesh});
-    }
-    benchmark::DoNotOptimize(points.data());
+    coloc::testing::standardSweepRanges(spec, street().hits, rng, kept);
+    benchmark::DoNotOptimize(kept.data());
   }
-  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * hits.size()));
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * street().hits.size()));
 }
 
 void BM_SweepNoise(benchmark::State& state) {

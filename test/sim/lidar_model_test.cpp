@@ -5,6 +5,7 @@
 #include <random>
 
 #include "coloc/sim/lidar_model.hpp"
+#include "standard_sweep.hpp"
 
 namespace coloc::sim {
 namespace {
@@ -159,18 +160,8 @@ TEST(LidarModel, SweepNoiseIsTheStandardDrawsPerRayWhateverTheRaysHit) {
   // The reference: the standard distributions on std::mt19937_64, each kept point's range written back
   // as a hit, which a sweep without noise or dropouts turns into the same point.
   std::mt19937_64 reference(99);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  std::vector<RayHit> kept(rays);
-  for (std::size_t i = 0; i < rays; ++i) {
-    const double n = noise(reference), u = uniform(reference);
-    if (hits[i].distance < 0.0f) continue;
-    const double r = hits[i].distance;
-    if (u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
-    const double range = r + n * (spec.range_noise + spec.range_noise_per_m * r);
-    if (range < spec.min_range || range > spec.max_range) continue;
-    kept[i] = {static_cast<float>(range), hits[i].mesh};
-  }
+  std::vector<RayHit> kept;
+  coloc::testing::standardSweepRanges(spec, hits, reference, kept);
   LidarSpec exact = spec;
   exact.range_noise = exact.range_noise_per_m = exact.dropout = exact.dropout_at_max_range = 0.0;
   exact.min_range = 0.0;
