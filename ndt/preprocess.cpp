@@ -88,8 +88,6 @@ struct VoxelSum {
   int count = 0;
 };
 
-// One point per occupied voxel, the centroid of the points `pointAt(i, point, time)` gives for
-// i = 0 .. count - 1 (false: no point), in order of first appearance.
 // Voxel -> its sum, by direct lookup for the voxels within kReach of the sensor's horizontally and
 // kReachZ vertically (a scan's, at the voxel sizes NDT downsamples with: 256 KB, cache-resident), by
 // hash for the rest. The table is the thread's, kept between scans; only the cells a scan used are
@@ -136,8 +134,9 @@ class VoxelSlots {
   std::vector<std::size_t> far_sums_;
 };
 
-// One point per occupied voxel, the centroid of the cloud's points as staged (cropped, moved) in runs:
-// `runAt(i, motion)` gives the motion of the run that starts at point i and returns where it ends.
+// One point per occupied voxel, the centroid of the cloud's points as staged (cropped, moved) in runs,
+// in order of first appearance: `runAt(i, motion)` gives the motion of the run that starts at point i
+// and returns where it ends.
 // `zero_times`: the points' times are 0 after the motion (deskewed), else their own.
 template <typename RunAt>
 PointCloud voxelCentroids(const PointCloud& cloud, const StageBounds& bounds, bool zero_times, RunAt&& runAt) {
