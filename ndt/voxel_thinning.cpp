@@ -12,9 +12,11 @@ namespace coloc::ndt {
 // come first), then the new voxels in order of first appearance; a voxel without new points gives its
 // point back unchanged ((0 + x) / 1 is x, x a float, and 0 + x is never -0); one with new points gives
 // (0 + x + p1 + p2 ...) / (1 + n). Each centroid stays in its voxel, so the cloud's points stay alone in
-// theirs: the points of a voxel are floats of like magnitude whose sum in double is exact, the mean is
-// then rounded once and lies between the smallest and the largest of them, and scaling and rounding
-// are monotonic, so its voxel is theirs (and a mean of points in [k, k+1) voxels is not -0).
+// theirs: a mean can only leave its voxel near a bound, where all its points are, of like magnitude,
+// and the sum of such floats in double is exact; the mean, rounded once, then lies between the
+// smallest and the largest of them, and scaling and rounding are monotonic, so its voxel is theirs
+// (nor is it -0: the points of a voxel below 0 are at most the largest negative float). The tests
+// put points on and around voxel bounds, -0 and denormals through pass after pass.
 struct VoxelThinning::Impl {
   static constexpr std::uint32_t kUntouched = 0xFFFFFFFFu;
   struct Sum {
