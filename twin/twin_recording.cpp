@@ -26,6 +26,7 @@
 #include "coloc/sim/vehicle_body.hpp"
 #include "coloc/replay/replay_cache.hpp"
 #include "coloc/replay/svg_plot.hpp"
+#include "scan_pool.hpp"
 
 namespace coloc::twin {
 
@@ -61,11 +62,12 @@ void toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp, io::
   }
 }
 
-// The sweep as the pipeline decodes toPointCloud2's message (pipeline::toPointCloud): its finite points,
-// each point's time in seconds after the earliest point's (the difference taken in double, as there),
-// without the message in between. Tested against the decoded file.
-ndt::PointCloud scanOf(const std::vector<sim::LidarPoint>& sweep) {
-  ndt::PointCloud cloud;
+// The sweep as the pipeline decodes toPointCloud2's message (pipeline::toPointCloud), into `cloud`: its
+// finite points, each point's time in seconds after the earliest point's (the difference taken in
+// double, as there), without the message in between. Tested against the decoded file.
+void scanOf(const std::vector<sim::LidarPoint>& sweep, ndt::PointCloud& cloud) {
+  cloud.points.clear();
+  cloud.times.clear();
   cloud.points.reserve(sweep.size());
   double first = std::numeric_limits<double>::infinity();
   for (const sim::LidarPoint& p : sweep) {
@@ -73,11 +75,10 @@ ndt::PointCloud scanOf(const std::vector<sim::LidarPoint>& sweep) {
     cloud.points.push_back(p.position);
     first = std::min(first, static_cast<double>(p.time));
   }
-  if (cloud.points.empty()) return cloud;
+  if (cloud.points.empty()) return;
   cloud.times.reserve(cloud.points.size());
   for (const sim::LidarPoint& p : sweep)
     if (p.position.allFinite()) cloud.times.push_back(static_cast<float>(static_cast<double>(p.time) - first));
-  return cloud;
 }
 
 // The drive's log: written as rosbag2, kept in memory, or both.
@@ -112,7 +113,7 @@ class LogRecorder {
     m.log_time = log_time;
     messages_.push_back(std::move(m));
     decoded_.resize(messages_.size());
-    decoded_.back() = {stamp, std::make_shared<const ndt::PointCloud>(scanOf(sweep))};
+    decoded_.back() = {stamp, ScanPool::shared().make(sweep.size(), [&](ndt::PointCloud& cloud) { scanOf(sweep, cloud); })};
   }
   std::shared_ptr<const replay::RecordedLog> close() {
     if (bag_) bag_->close();
