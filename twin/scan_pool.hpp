@@ -14,6 +14,7 @@ namespace coloc::twin {
 
 class ScanPool {
  public:
+  /// A pool must outlive the scans it hands out (their last holder gives them back to it).
   explicit ScanPool(std::size_t max_bytes);
   ScanPool(const ScanPool&) = delete;
   ScanPool& operator=(const ScanPool&) = delete;
