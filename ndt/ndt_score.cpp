@@ -248,8 +248,6 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
 #pragma omp parallel num_threads(threads)
   {
     const std::size_t thread = static_cast<std::size_t>(omp_get_thread_num());
-    std::vector<double> best(m);
-    std::vector<char> found(m);
     // The cells this point's shifts fell into so far, and their lists: nearby shifts share a cell.
     std::vector<std::pair<std::uint64_t, CellNeighbours::List>> seen;
     std::vector<std::uint32_t> scratch;
@@ -272,17 +270,18 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
           list = cells.get(cell, key, scratch);
           if (list.kept) seen.emplace_back(key, list);  // a list not kept lasts one use
         }
-        found[j] = 0;
+        double best = 0.0;
+        bool found = false;
         for (std::uint32_t i = 0; i < list.size; ++i) {
           const Voxel& v = voxels.voxels()[list.voxels[i]];
           const Vector3d q = shifted - v.mean;
           if (q.squaredNorm() > radius_sq) continue;
           const double exponent = -0.5 * k.d2 * q.dot(v.inverse_covariance * q);
-          if (!found[j] || exponent > best[j]) best[j] = exponent;
-          found[j] = 1;
+          if (!found || exponent > best) best = exponent;
+          found = true;
         }
-        if (found[j]) {
-          sums[thread][j] += -k.d1 * std::exp(best[j]);
+        if (found) {
+          sums[thread][j] += -k.d1 * std::exp(best);
           ++counts[thread][j];
         }
       }
