@@ -2,10 +2,12 @@
 // castOneByOne (one ray at a time on one thread, the reference), in the same run, on a street of
 // houses, trees and cars seen by a 32-beam LiDAR sweep (57,600 rays). And the sweep's noise: the points
 // sim::sweepPoints makes of those hits (range noise and dropouts, two draws per ray) against the same
-// loop on the standard library's engine and distributions, which give the same draws (one thread).
+// loop on the standard library's engine and distributions, which give the same draws (one thread); and
+// the twin's engine against std::mt19937_64, which gives the same numbers, a million numbers at a time.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <random>
 
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/sim/ray_caster.hpp"
@@ -77,10 +79,23 @@ void BM_SweepNoise(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * street().hits.size()));
 }
 
+template <typename Engine>
+void BM_RandomNumbers(benchmark::State& state) {
+  Engine engine(1);
+  std::uint64_t sum = 0;
+  for (auto _ : state) {
+    for (int i = 0; i < 1000000; ++i) sum += engine();
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * 1000000);
+}
+
 BENCHMARK(BM_CastOneByOne)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_CastPackets)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_SweepNoiseStandardLibrary)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_SweepNoise)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_RandomNumbers, std::mt19937_64)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_TEMPLATE(BM_RandomNumbers, coloc::sim::RandomEngine)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
 }  // namespace
 
