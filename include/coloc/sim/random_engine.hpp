@@ -27,7 +27,11 @@ class RandomEngine {
   /// std::uniform_real_distribution<double>(0, 1)) gives with libstdc++, on every standard library.
   double canonical() { return canonicalOf((*this)()); }
   static double canonicalOf(result_type number) {
-    const double u = static_cast<double>(number) * 0x1p-64;
+    // number * 2^-64 rounded once, as converting the whole number would round it: both halves convert
+    // and scale exactly, and their sum is the one rounding. A 64-bit unsigned conversion branches on
+    // the top bit, a coin toss the processor mispredicts every other time.
+    const double u = static_cast<double>(static_cast<std::int64_t>(number >> 32)) * 0x1p-32 +
+                     static_cast<double>(static_cast<std::int64_t>(number & 0xFFFFFFFFu)) * 0x1p-64;
     return u < 1.0 ? u : 0x1.fffffffffffffp-1;  // the numbers that round up to 2^64: the largest double below 1
   }
 
