@@ -3,6 +3,7 @@
 // in memory holds about 250 decoded scans of 640 KB; fresh memory costs a page fault and the kernel's
 // zeroing every 4 KB, which was half of the experiment's page faults. A scan given back by its last
 // holder goes to the pool while the pool holds less than its bound, else back to the system.
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <mutex>
@@ -23,24 +24,33 @@ class ScanPool {
   static ScanPool& shared();
 
   /// An empty cloud with the room of a scan given back, the smallest with room for `points` points
-  /// and times (else fresh memory); `fill` fills it, and it is given back to this pool when its last
-  /// holder lets go.
+  /// and times (else fresh memory, with room for a quarter more); `fill` fills it, and it is given
+  /// back to this pool when its last holder lets go.
   template <typename Fill>
   std::shared_ptr<const ndt::PointCloud> make(std::size_t points, Fill&& fill) {
-    std::unique_ptr<ndt::PointCloud> cloud = take(points);
-    fill(*cloud);
-    return std::shared_ptr<const ndt::PointCloud>(cloud.release(), [this](const ndt::PointCloud* c) { give(const_cast<ndt::PointCloud*>(c)); });
+    Spare taken = take(points);
+    fill(*taken.cloud);
+    const std::size_t touched = std::max(taken.touched, filledBytes(*taken.cloud));
+    return std::shared_ptr<const ndt::PointCloud>(taken.cloud.release(),
+                                                  [this, touched](const ndt::PointCloud* c) { give(const_cast<ndt::PointCloud*>(c), touched); });
   }
-  /// Bytes of room the pool holds now.
+
+  /// Bytes the scans the pool holds now have filled: the memory they hold (room never filled is
+  /// never given memory by the system).
   std::size_t bytes() const;
 
  private:
-  std::unique_ptr<ndt::PointCloud> take(std::size_t points);
-  void give(ndt::PointCloud* cloud);
+  struct Spare {
+    std::unique_ptr<ndt::PointCloud> cloud;
+    std::size_t touched = 0;  ///< the most its points and times ever filled, bytes
+  };
+  static std::size_t filledBytes(const ndt::PointCloud& c);
+  Spare take(std::size_t points);
+  void give(ndt::PointCloud* cloud, std::size_t touched);
 
   const std::size_t max_bytes_;
   mutable std::mutex mutex_;
-  std::vector<std::unique_ptr<ndt::PointCloud>> spare_;
+  std::vector<Spare> spare_;
   std::size_t bytes_ = 0;
 };
 
