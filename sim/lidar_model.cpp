@@ -116,6 +116,12 @@ class PolarPairs {
 }  // namespace
 
 std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose) {
+  std::vector<RayHit> hits;
+  castSweep(spec, world, pose, hits);
+  return hits;
+}
+
+void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::vector<RayHit>& hits) {
   const int lasers = static_cast<int>(spec.vertical_deg.size());
   const int firings = firingsPerSweep(spec);
   const double sweep = 1.0 / spec.rotation_hz;
@@ -136,9 +142,7 @@ std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, con
       directions[i] = (sensor.linear() * local[i]).normalized().cast<float>();
     }
   }
-  std::vector<RayHit> hits;
   world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
-  return hits;
 }
 
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng) {

@@ -184,15 +184,31 @@ bool neighboursNear(const sim::Scenario& scenario, const sim::Route& route, cons
   return false;
 }
 
-std::vector<Eigen::Vector3f> positionsOf(const std::vector<sim::LidarPoint>& points) {
-  std::vector<Eigen::Vector3f> frame;
+void positionsOf(const std::vector<sim::LidarPoint>& points, std::vector<Eigen::Vector3f>& frame) {
+  frame.clear();
   frame.reserve(points.size());
   for (const auto& p : points) frame.push_back(p.position);
-  return frame;
+}
+
+// An RSU's frame into `frame`, its rays' hits and points in `room`: the room of a frame (1-2 MB) is
+// kept from frame to frame instead of fresh memory each time.
+struct FrameRoom {
+  std::vector<sim::RayHit> hits;
+  std::vector<sim::LidarPoint> points;
+};
+
+void frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, sim::RandomEngine& rng, FrameRoom& room,
+             std::vector<Eigen::Vector3f>& frame) {
+  sim::castSweep(spec, world, [&](double) { return pose; }, room.hits);
+  sim::sweepPoints(spec, room.hits, rng, room.points);
+  positionsOf(room.points, frame);
 }
 
 std::vector<Eigen::Vector3f> frameOf(const sim::LidarSpec& spec, const sim::RayCaster& world, const Eigen::Isometry3d& pose, sim::RandomEngine& rng) {
-  return positionsOf(sim::scanSweep(spec, world, [&](double) { return pose; }, rng));
+  FrameRoom room;
+  std::vector<Eigen::Vector3f> frame;
+  frameOf(spec, world, pose, rng, room, frame);
+  return frame;
 }
 
 std::uint64_t raysPerSweep(const sim::LidarSpec& spec) {
@@ -357,6 +373,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
   // The roof sweep and an RSU's sweep, their room kept from sweep to sweep.
   std::vector<sim::LidarPoint> sweep, rsu_sweep;
+  std::vector<Eigen::Vector3f> frame, ideal_frame;  // an RSU's frame, the ideal twin's
+  FrameRoom frame_room;
   for (int k = 0; k <= ticks; ++k) {  // 100 Hz
     const double t = k * 0.01;
     const sim::VehicleState truth = drive.at(t);
@@ -418,7 +436,6 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const Eigen::Isometry3d pose = Eigen::Translation3d(r.info.position.x(), r.info.position.y(), r.info.height) *
                                      Eigen::AngleAxisd(r.info.yaw, Eigen::Vector3d::UnitZ());
       const auto c1 = Clock::now();
-      std::vector<Eigen::Vector3f> frame;
       if (options.rsu_frames) {
         // Keyed by RSU and sweep; the fingerprint adds where the vehicle is, which the world holds.
         const sim::SensorTrajectory still = [&](double) { return pose; };
@@ -430,10 +447,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
                                                     return sim::castSweep(r.lidar, with_vehicle.caster(), still);
                                                   });
         sim::sweepPoints(r.lidar, *hits, rng, rsu_sweep);
-        frame = positionsOf(rsu_sweep);
+        positionsOf(rsu_sweep, frame);
       } else {
         placeVehicle();
-        frame = frameOf(r.lidar, with_vehicle.caster(), pose, rng);
+        frameOf(r.lidar, with_vehicle.caster(), pose, rng, frame_room, frame);
       }
       summary.ray_casting_seconds += since(c1);
       summary.rays += raysPerSweep(r.lidar);
@@ -470,7 +487,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       record.refusal = d.refusal;
       record.fit_points = d.fit_points;
       if (r.ideal_perception) {
-        const std::vector<Eigen::Vector3f> ideal_frame = frameOf(r.ideal_lidar, ideal_world->caster(), pose, ideal_rng);
+        frameOf(r.ideal_lidar, ideal_world->caster(), pose, ideal_rng, frame_room, ideal_frame);
         sim::VehicleDetection di = r.ideal_perception->detect(ideal_frame, at(capture), reference, seen.yaw, ideal_world->egoBody().length,
                                                                     ideal_world->egoBody().width);
         confirm(di, r.ideal_consistency);

@@ -52,6 +52,8 @@ std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world,
 
 /// scanSweep in its two halves. The geometry: every ray's hit, firing-major, lasers in spec order...
 std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose);
+/// (into `hits`, its room kept from sweep to sweep: fresh room costs page faults)
+void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::vector<RayHit>& hits);
 /// ...and the points those hits give with the spec's noise and dropouts drawn from `rng` (two draws per
 /// ray, hit or not). Throws coloc::Error if `hits` is not a sweep of this spec.
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng);
