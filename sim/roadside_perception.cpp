@@ -146,9 +146,19 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
                                       std::clamp(lidar_local.y(), -0.5 * width, 0.5 * width));
   const double footprint_range = (lidar_local - nearest_local).norm();
   constexpr double kOccluderClearance = 0.3;  // m nearer than the footprint: the footprint's own error and noise
+  // A point whose bearing is further off the expected one than the sector reaches on either side is
+  // outside it: a cosine against a bound rules out most near points without the two arc tangents and
+  // the wrap. The margin, a microradian, is far above either way's rounding (1e-15), so every point
+  // is decided as the exact test alone decides it.
+  const double reach = std::max(-bearing_lo, bearing_hi) + 1e-6;
+  const double cos_reach = reach < M_PI ? std::cos(reach) : -2.0;
+  const Eigen::Vector2d toward(std::cos(bearing0), std::sin(bearing0));
   const auto inSector = [&](const Eigen::Vector2d& xy) {
     // Range first: most of a frame lies beyond the vehicle, and needs no bearing.
-    if (!((xy - lidar).norm() < footprint_range - kOccluderClearance)) return false;
+    const Eigen::Vector2d d = xy - lidar;
+    const double range = d.norm();
+    if (!(range < footprint_range - kOccluderClearance)) return false;
+    if (d.dot(toward) < cos_reach * range) return false;
     const double b = wrapAngle(std::atan2(xy.y() - lidar.y(), xy.x() - lidar.x()) - bearing0);
     return b >= bearing_lo && b <= bearing_hi;
   };
