@@ -15,7 +15,7 @@ using namespace coloc::twin;
 void addExperimentCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("experiment",
                                  "The paper's experiment on the digital twin: NDT only against NDT + roadside fusion with a VLP-16 and a "
-                                 "VLP-32C, at sites A and B, over trials and a network grid; tables and figures");
+                                 "VLP-32C, at the built-in sites (A, B, C) or your own, over trials and a network grid; tables and figures");
   static std::string file, out_dir = "results/experiment";
   static int trials = 0, jobs = 0;
   static bool quick = false, sweeps = false, no_network = false, recordings = false;
@@ -23,7 +23,7 @@ void addExperimentCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "results folder")->capture_default_str();
   cmd->add_option("--trials", trials, "trials per site (default 10)");
-  cmd->add_flag("--quick", quick, "one trial of everything: a first look in a minute or two");
+  cmd->add_flag("--quick", quick, "one trial of everything: a first look in under a minute on two cores");
   cmd->add_flag("--sweeps", sweeps, "also sweep the RSU covariance, the RSU height and the speed");
   cmd->add_flag("--no-network", no_network, "skip the network grid (Tables II and III)");
   cmd->add_flag("--recordings", recordings, "keep each drive's rosbag2 log under OUT/recordings/ (a few hundred MB per drive)");
