@@ -371,9 +371,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const sim::LidarSpec roof = sim::withErrors(sim::lidarNamed(scenario.vehicle_lidar), errors);
   const sim::OdometryNoise& odometry_noise = scenario.odometry;
   const int ticks = static_cast<int>(std::floor(drive.duration() * 100.0));
-  // The roof sweep and an RSU's sweep, their room kept from sweep to sweep.
-  std::vector<sim::LidarPoint> sweep, rsu_sweep;
-  std::vector<Eigen::Vector3f> frame, ideal_frame;  // an RSU's frame, the ideal twin's
+  // The roof sweep, an RSU's frame and the ideal twin's, their room kept from sweep to sweep.
+  std::vector<sim::LidarPoint> sweep;
+  std::vector<Eigen::Vector3f> frame, ideal_frame;
   FrameRoom frame_room;
   for (int k = 0; k <= ticks; ++k) {  // 100 Hz
     const double t = k * 0.01;
@@ -446,8 +446,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
                                                     placeVehicle();
                                                     return sim::castSweep(r.lidar, with_vehicle.caster(), still);
                                                   });
-        sim::sweepPoints(r.lidar, *hits, rng, rsu_sweep);
-        positionsOf(rsu_sweep, frame);
+        sim::sweepPoints(r.lidar, *hits, rng, frame_room.points);
+        positionsOf(frame_room.points, frame);
       } else {
         placeVehicle();
         frameOf(r.lidar, with_vehicle.caster(), pose, rng, frame_room, frame);
