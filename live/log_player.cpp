@@ -31,6 +31,9 @@ rsu_client::TopicQos recordedQos(const io::TopicInfo& topic) {
 
 PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
   if (!(options.rate > 0.0) || !std::isfinite(options.rate)) throw Error("play: the rate must be a finite number > 0");
+  if (!(options.clock_frequency >= 1.0 && options.clock_frequency <= 1e4))
+    throw Error("play: the clock frequency must be a number of Hz in [1, 10000]");
+  if (!(std::isfinite(options.delay) && options.delay >= 0.0)) throw Error("play: the delay before the first message must be a finite number of seconds >= 0");
   io::BagReader probe = io::BagReader::open(log_path);
   for (const std::string& wanted : options.topics) {
     const auto& all = probe.topics();

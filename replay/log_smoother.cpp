@@ -104,6 +104,8 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   if (options.window > 0.0 && options.calibrate_rsus)
     throw Error("smooth: RSU calibration takes the whole drive at once; it does not run in a fixed-lag window");
   if (options.window < 0.0 || !std::isfinite(options.window)) throw Error("smooth: the window must be a finite number of seconds >= 0");
+  if (options.window > 0.0 && !(std::isfinite(options.window_step) && options.window_step > 0.0))
+    throw Error("smooth: the window step must be a finite number of seconds > 0");
   options.replay.keep_filter_inputs = true;
   SmoothResult result;
   result.filter = replayLog(log_path, options.replay);

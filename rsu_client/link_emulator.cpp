@@ -1,10 +1,43 @@
 #include "coloc/rsu_client/link_emulator.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "coloc/core/error.hpp"
 
 namespace coloc::rsu_client {
 
-LinkEmulator::LinkEmulator(const LinkConfig& config) : config_(config), rng_(config.seed) {}
+namespace {
+
+std::string shown(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// A delay or loss outside its range would not fail loudly: a negative delay is taken as none, a loss
+// above 1 drops everything, a NaN loss drops nothing.
+void check(const LinkConfig& c) {
+  const auto seconds = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v >= 0.0)) throw Error(std::string("link: ") + name + " must be a finite number of seconds >= 0 (got " + shown(v) + ")");
+  };
+  const auto probability = [](double v, const char* name) {
+    if (!(v >= 0.0 && v <= 1.0)) throw Error(std::string("link: ") + name + " must be a probability in [0, 1] (got " + shown(v) + ")");
+  };
+  seconds(c.delay, "delay");
+  seconds(c.jitter, "jitter");
+  probability(c.loss, "loss");
+  probability(c.p_good_to_bad, "p_good_to_bad");
+  probability(c.p_bad_to_good, "p_bad_to_good");
+  probability(c.loss_in_good, "loss_in_good");
+  probability(c.loss_in_bad, "loss_in_bad");
+}
+
+}  // namespace
+
+LinkEmulator::LinkEmulator(const LinkConfig& config) : config_(config), rng_(config.seed) { check(config); }
 
 std::optional<Stamp> LinkEmulator::transmit(Stamp sent) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);

@@ -8,6 +8,7 @@
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/preprocess.hpp"
 #include "commands.hpp"
+#include "number_checks.hpp"
 
 namespace coloc::tools {
 
@@ -34,7 +35,7 @@ void addAlignCommand(CLI::App& app) {
   cmd->add_option("--step-size", step, "first trust-region radius (Autoware's longest step), m")->capture_default_str();
   cmd->add_option("--epsilon", epsilon, "stop when the squared step translation is below this, m^2")->capture_default_str();
   cmd->add_option("--max-iterations", iterations, "iteration limit")->capture_default_str();
-  cmd->add_option("--source-voxel", source_voxel, "voxel size the source is downsampled with, m (0 = none)")->capture_default_str();
+  cmd->add_option("--source-voxel", source_voxel, "voxel size the source is downsampled with, m (0 = none)")->check(finiteNumber(0.0))->capture_default_str();
   cmd->add_option("--nvtl-threshold", nvtl_threshold, "quality gate on the result")->capture_default_str();
   cmd->add_option("--covariance", covariance, "fixed, laplace or multi_ndt_score")
       ->check(CLI::IsMember({"fixed", "laplace", "multi_ndt_score"}))->capture_default_str();

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "coloc/twin/experiment.hpp"
 #include "coloc/twin/experiment_report.hpp"
 
@@ -22,12 +23,12 @@ void addExperimentCommand(CLI::App& app) {
   cmd->add_option("FILE", file, "experiment YAML overriding the defaults (keys: see experiment_config.hpp or the README)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "results folder")->capture_default_str();
-  cmd->add_option("--trials", trials, "trials per site (default 10)");
+  cmd->add_option("--trials", trials, "trials per site (default 10)")->check(wholeNumber(1, 1000));
   cmd->add_flag("--quick", quick, "one trial of everything: a first look in under a minute on two cores");
   cmd->add_flag("--sweeps", sweeps, "also sweep the RSU covariance, the RSU height and the speed");
   cmd->add_flag("--no-network", no_network, "skip the network grid (Tables II and III)");
   cmd->add_flag("--recordings", recordings, "keep each drive's rosbag2 log under OUT/recordings/ (a few hundred MB per drive)");
-  cmd->add_option("--jobs", jobs, "replays run side by side (default 2)");
+  cmd->add_option("--jobs", jobs, "replays run side by side (default 2)")->check(wholeNumber(1, 64));
   cmd->callback([app = &app] {
     ExperimentConfig config = file.empty() ? ExperimentConfig{} : loadExperimentConfig(file);
     if (quick) config = quickExperiment(config);

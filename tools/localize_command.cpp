@@ -12,6 +12,7 @@
 #include "coloc/io/trajectory_file.hpp"
 #include "coloc/live/live_localizer.hpp"
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "dds_options.hpp"
 #include "teardown_watchdog.hpp"
 
@@ -64,8 +65,8 @@ void addLocalizeCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "where fused.tum and summary.json go when it stops")->capture_default_str();
   cmd->add_flag("--use-sim-time", sim_time, "run on the time received on /clock (as a ROS 2 node with use_sim_time, for `coloc play`)");
-  cmd->add_option("--duration", duration, "stop after this many seconds (0 = until SIGINT or SIGTERM)");
-  cmd->add_option("--idle-exit", idle, "stop once no input arrived for this many seconds, after the first (0 = never)");
+  cmd->add_option("--duration", duration, "stop after this many seconds (0 = until SIGINT or SIGTERM)")->check(finiteNumber(0.0));
+  cmd->add_option("--idle-exit", idle, "stop once no input arrived for this many seconds, after the first (0 = never)")->check(finiteNumber(0.0));
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
   addDdsOptions(cmd, dds);
   cmd->callback([] {

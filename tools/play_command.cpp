@@ -5,6 +5,7 @@
 
 #include "coloc/live/log_player.hpp"
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "dds_options.hpp"
 #include "progress.hpp"
 #include "teardown_watchdog.hpp"
@@ -25,12 +26,12 @@ void addPlayCommand(CLI::App& app) {
   static bool no_clock = false;
   static DdsOptions dds;
   cmd->add_option("LOG", log, "the recording")->required();
-  cmd->add_option("--rate", options.rate, "playback speed: 2 = twice as fast as recorded")->capture_default_str();
+  cmd->add_option("--rate", options.rate, "playback speed: 2 = twice as fast as recorded")->check(finiteNumber(0.0, 1000.0, true))->capture_default_str();
   cmd->add_option("--topics", options.topics, "play only these topics");
   cmd->add_flag("--loop", options.loop, "start again at the end, until interrupted");
   cmd->add_flag("--no-clock", no_clock, "do not publish the log's time on /clock");
-  cmd->add_option("--clock-frequency", options.clock_frequency, "Hz of /clock between messages")->capture_default_str();
-  cmd->add_option("--delay", options.delay, "seconds to wait before the first message, for discovery")->capture_default_str();
+  cmd->add_option("--clock-frequency", options.clock_frequency, "Hz of /clock between messages")->check(finiteNumber(1.0, 10000.0))->capture_default_str();
+  cmd->add_option("--delay", options.delay, "seconds to wait before the first message, for discovery")->check(finiteNumber(0.0, 3600.0))->capture_default_str();
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
   addDdsOptions(cmd, dds);
   cmd->callback([] {

@@ -12,6 +12,7 @@
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "dds_options.hpp"
 #include "teardown_watchdog.hpp"
 
@@ -48,15 +49,19 @@ void addRsuListenCommand(CLI::App& app) {
   static double timeout = 0.0, idle = 0.0;
   static std::vector<double> dimensions;
   cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
-  cmd->add_option("--count", count, "exit after this many fixes (0 = run until --timeout or Ctrl-C)");
-  cmd->add_option("--timeout", timeout, "exit after this many seconds (0 = no limit)");
-  cmd->add_option("--idle-exit", idle, "exit once this many seconds pass without a fix, after the first (0 = never)");
+  cmd->add_option("--count", count, "exit after this many fixes (0 = run until --timeout or Ctrl-C)")->check(wholeNumber(0, 1000000000));
+  cmd->add_option("--timeout", timeout, "exit after this many seconds (0 = no limit)")->check(finiteNumber(0.0));
+  cmd->add_option("--idle-exit", idle, "exit once this many seconds pass without a fix, after the first (0 = never)")->check(finiteNumber(0.0));
   cmd->add_option("--dimensions", dimensions,
                   "publish this vehicle's dimensions for the RSUs, twice a second as CAMs repeat: station_id length width")
       ->expected(3);
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
   addDdsOptions(cmd, dds);
   cmd->callback([] {
+    if (!dimensions.empty() &&
+        !(dimensions[0] >= 0.0 && dimensions[0] <= 4294967295.0 && dimensions[0] == std::floor(dimensions[0]) && std::isfinite(dimensions[1]) &&
+          dimensions[1] > 0.0 && std::isfinite(dimensions[2]) && dimensions[2] > 0.0))
+      throw Error("rsu-listen: --dimensions takes a station id (a whole number below 2^32) and a length and width > 0 in metres");
     rsu_client::FixChecker checker(rsu_client::RsuRegistry::load(registry_path));
     std::vector<std::string> ids;
     for (const auto& r : checker.registry().rsus()) ids.push_back(r.id);
@@ -127,15 +132,15 @@ void addRsuPublishCommand(CLI::App& app) {
   cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
   cmd->add_option("--rsu", rsu, "the RSU id to publish as")->required();
   cmd->add_option("--from", from, "fixes from a CSV file: t_offset_s,x,y per line");
-  cmd->add_option("--generate", generate, "generate this many fixes of a vehicle driving past the RSU");
-  cmd->add_option("--speed", speed, "speed of the generated vehicle, m/s")->capture_default_str();
-  cmd->add_option("--rate", rate, "fixes per second")->capture_default_str();
-  cmd->add_option("--wait-subscribers", wait_subscribers, "wait for this many listeners before sending")->capture_default_str();
-  cmd->add_option("--wait-timeout", wait_timeout, "seconds to wait for them")->capture_default_str();
+  cmd->add_option("--generate", generate, "generate this many fixes of a vehicle driving past the RSU")->check(wholeNumber(0, 1000000));
+  cmd->add_option("--speed", speed, "speed of the generated vehicle, m/s")->check(finiteNumber(0.0, 100.0))->capture_default_str();
+  cmd->add_option("--rate", rate, "fixes per second")->check(finiteNumber(0.0, 1000.0, true))->capture_default_str();
+  cmd->add_option("--wait-subscribers", wait_subscribers, "wait for this many listeners before sending")->check(wholeNumber(0, 1000))->capture_default_str();
+  cmd->add_option("--wait-timeout", wait_timeout, "seconds to wait for them")->check(finiteNumber(0.0, 3600.0))->capture_default_str();
   cmd->add_flag("--dimensions", dimensions, "print the vehicle dimensions received on /vehicle/dimensions (the CAM content)");
-  cmd->add_option("--delay", link.delay, "emulated link delay, s")->capture_default_str();
-  cmd->add_option("--jitter", link.jitter, "emulated delay jitter (standard deviation), s")->capture_default_str();
-  cmd->add_option("--loss", link.loss, "emulated independent loss probability")->capture_default_str();
+  cmd->add_option("--delay", link.delay, "emulated link delay, s")->check(finiteNumber(0.0, 10.0))->capture_default_str();
+  cmd->add_option("--jitter", link.jitter, "emulated delay jitter (standard deviation), s")->check(finiteNumber(0.0, 10.0))->capture_default_str();
+  cmd->add_option("--loss", link.loss, "emulated independent loss probability")->check(finiteNumber(0.0, 1.0))->capture_default_str();
   cmd->add_flag("--burst", link.burst, "bursty (Gilbert-Elliott) loss instead of independent");
   cmd->add_option("--seed", link.seed, "seed of the link emulation")->capture_default_str();
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix); default: the RSU id");

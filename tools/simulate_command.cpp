@@ -4,6 +4,7 @@
 
 #include "coloc/sim/scene.hpp"
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "progress.hpp"
 #include "coloc/twin/twin_recording.hpp"
 
@@ -19,12 +20,13 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_option("--out", out_dir,
                   "output folder: log/, map/, fuse.yaml, rsu_fixes.csv, rsu_frames.csv, rsu_fix_error.svg, rsu_perception.csv, rsu_perception.svg")
       ->capture_default_str();
-  cmd->add_option("--delay", options.link.delay, "V2I delay of the fixes, s")->capture_default_str();
-  cmd->add_option("--jitter", options.link.jitter, "V2I delay jitter, s")->capture_default_str();
-  cmd->add_option("--loss", options.link.loss, "V2I loss probability")->capture_default_str();
+  cmd->add_option("--delay", options.link.delay, "V2I delay of the fixes, s")->check(finiteNumber(0.0, 10.0))->capture_default_str();
+  cmd->add_option("--jitter", options.link.jitter, "V2I delay jitter, s")->check(finiteNumber(0.0, 10.0))->capture_default_str();
+  cmd->add_option("--loss", options.link.loss, "V2I loss probability")->check(finiteNumber(0.0, 1.0))->capture_default_str();
   cmd->add_option("--rsu-processing", options.rsu_processing,
                   "time the RSU takes from the end of its sweep to sending the fix, s (simulated, so runs repeat; "
                   "the measured time is in rsu_fixes.csv)")
+      ->check(finiteNumber(0.0, 10.0))
       ->capture_default_str();
   cmd->add_flag("--compare-ideal", options.ideal_comparison,
                "also image every RSU frame in the ideal twin (no error sources) and fix it: ideal_error_m in rsu_frames.csv, beside "

@@ -10,6 +10,7 @@
 #include "coloc/replay/log_smoother.hpp"
 #include "coloc/replay/svg_plot.hpp"
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "log_options.hpp"
 #include "progress.hpp"
 
@@ -45,8 +46,9 @@ void addSmoothCommand(CLI::App& app) {
   static bool calibrate = false;
   static double window = 0.0, window_step = 0.5;
   cmd->add_option("--window", window, "fixed-lag mode: a window of this many seconds behind the filter (0 = the whole log at once)")
+      ->check(finiteNumber(0.0))
       ->capture_default_str();
-  cmd->add_option("--window-step", window_step, "how far the window moves each time, s")->capture_default_str();
+  cmd->add_option("--window-step", window_step, "how far the window moves each time, s")->check(finiteNumber(0.0, std::numeric_limits<double>::infinity(), true))->capture_default_str();
   cmd->add_flag("--calibrate-rsus", calibrate,
                 "estimate each RSU's survey and clock offsets with the trajectory; writes rsu_calibrated.yaml for the next drives");
   cmd->callback([] {

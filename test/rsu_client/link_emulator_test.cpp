@@ -1,5 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "coloc/core/error.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 
 namespace coloc::rsu_client {
@@ -84,6 +90,40 @@ TEST(LinkEmulator, LargeJitterNeverDeliversBeforeSending) {
   config.delay = 0.001;
   config.jitter = 0.05;
   EXPECT_GE(simulate(config, 5000).min_delay, 0.0);
+}
+
+// A delay or loss outside its range is an error naming the field, not a link that silently delivers
+// at once (negative delay), drops everything (loss above 1) or drops nothing (NaN).
+TEST(LinkEmulator, RefusesADelayOrProbabilityOutsideItsRangeNamingTheField) {
+  const auto message = [](const LinkConfig& c) {
+    try {
+      LinkEmulator link(c);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const double nan = std::nan("");
+  struct Case {
+    LinkConfig config;
+    const char* field;
+  };
+  std::vector<Case> cases;
+  LinkConfig c;
+  c.delay = -0.01, cases.push_back({c, "delay"}), c = LinkConfig();
+  c.delay = nan, cases.push_back({c, "delay"}), c = LinkConfig();
+  c.jitter = std::numeric_limits<double>::infinity(), cases.push_back({c, "jitter"}), c = LinkConfig();
+  c.loss = 1.5, cases.push_back({c, "loss"}), c = LinkConfig();
+  c.loss = nan, cases.push_back({c, "loss"}), c = LinkConfig();
+  c.p_good_to_bad = -0.1, cases.push_back({c, "p_good_to_bad"}), c = LinkConfig();
+  c.loss_in_bad = 2.0, cases.push_back({c, "loss_in_bad"}), c = LinkConfig();
+  for (const Case& k : cases) {
+    const std::string what = message(k.config);
+    EXPECT_NE(what.find(std::string("link: ") + k.field + " must be"), std::string::npos) << k.field << ": '" << what << "'";
+  }
+  LinkConfig edges;
+  edges.delay = 0.0, edges.jitter = 0.0, edges.loss = 1.0, edges.loss_in_good = 0.0, edges.loss_in_bad = 1.0;
+  EXPECT_EQ(message(edges), "");  // the bounds themselves are allowed
 }
 
 }  // namespace
