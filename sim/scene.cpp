@@ -45,11 +45,13 @@ SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& 
     r.keys(n, where, {"type", "center", "size", "yaw", "in_world", "in_map"});
     const Eigen::Vector2d c = r.vec2(r.require(n, "center", where), where + ".center");
     const Eigen::Vector3d s = r.vec3(r.require(n, "size", where), where + ".size");
+    if (!(s.minCoeff() > 0.0)) r.fail(n["size"], where + ".size", "each of [length, width, height] must be > 0");
     const double yaw = n["yaw"] ? r.number(n["yaw"], where + ".yaw") : 0.0;
     o.mesh = box(Eigen::Vector3f(static_cast<float>(c.x()), static_cast<float>(c.y()), 0.0f), s.cast<float>(), static_cast<float>(yaw));
   } else if (o.type == "wall") {
     r.keys(n, where, {"type", "from", "to", "height", "thickness", "in_world", "in_map"});
     const Eigen::Vector2d a = r.vec2(r.require(n, "from", where), where + ".from"), b = r.vec2(r.require(n, "to", where), where + ".to");
+    if (!((b - a).norm() > 0.0)) r.fail(n["to"], where + ".to", "must differ from `from`: a wall needs a length");
     const double h = r.positive(r.require(n, "height", where), where + ".height");
     const double t = n["thickness"] ? r.positive(n["thickness"], where + ".thickness") : 0.3;
     const Eigen::Vector2d mid = 0.5 * (a + b);
@@ -166,8 +168,12 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
   for (std::size_t i = 0; i < pieces.size(); ++i) {
     const std::string where = "route.pieces[" + std::to_string(i) + "]";
     r.keys(pieces[i], where, {"length", "curvature"});
-    s.route.push_back({r.positive(r.require(pieces[i], "length", where), where + ".length"),
-                       pieces[i]["curvature"] ? r.number(pieces[i]["curvature"], where + ".curvature") : 0.0});
+    // A car turns on no less than about 4 m (its turning circle's radius at the rear axle is 4-6 m).
+    constexpr double kMaxCurvature = 0.25;  // 1/m
+    const double curvature = pieces[i]["curvature"] ? r.number(pieces[i]["curvature"], where + ".curvature") : 0.0;
+    if (std::abs(curvature) > kMaxCurvature)
+      r.fail(pieces[i]["curvature"], where + ".curvature", "must be within +-0.25 1/m (a radius of 4 m or more: a car's tightest turn)");
+    s.route.push_back({r.positive(r.require(pieces[i], "length", where), where + ".length"), curvature});
   }
   if (route["speed"]) s.speed.cruise = r.positive(route["speed"], "route.speed");
   if (route["acceleration"]) s.speed.acceleration = r.positive(route["acceleration"], "route.acceleration");

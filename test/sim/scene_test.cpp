@@ -34,6 +34,11 @@ TEST(Scenario, ErrorsNameTheKeyAndLine) {
   expectError("route: {start: [0, 0], pieces: []}\n", "expected a list of {length, curvature}");
   expectError(std::string(kRoute) + "vehicle: {lidar: HDL-64}\n", "unknown LiDAR model 'HDL-64'");
   expectError(std::string(kRoute) + "weather: rain\n", "weather: unknown key");
+  expectError(std::string("objects:\n  - {type: building, center: [0, 9], size: [10, -8, 5]}\n") + kRoute,
+              "s.yaml:2: objects[0].size: each of [length, width, height] must be > 0");
+  expectError(std::string("objects:\n  - {type: wall, from: [3, 4], to: [3, 4], height: 2}\n") + kRoute,
+              "objects[0].to: must differ from `from`");
+  expectError("route: {start: [0, 0], pieces: [{length: 20, curvature: 10}]}\n", "route.pieces[0].curvature: must be within +-0.25 1/m");
   expectError("objects: []\n", "needs route");
 }
 
