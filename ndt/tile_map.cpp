@@ -28,6 +28,16 @@ TileInfo boundsOf(const PointCloud& cloud, std::string path) {
 
 }  // namespace
 
+void TileMap::checkPath(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec)) return;
+  if (!fs::is_directory(path, ec)) throw Error(path + ": no such map file or folder");
+  for (const auto& entry : fs::directory_iterator(path, ec))
+    if (entry.is_regular_file() && entry.path().extension() == ".pcd") return;
+  throw Error(path + ": the map folder holds no .pcd tile");
+}
+
 TileMap TileMap::open(const std::string& path, double tile_size) {
   namespace fs = std::filesystem;
   std::error_code ec;

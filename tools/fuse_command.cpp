@@ -20,7 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace coloc::replay;
 
-void printSummary(const std::string& log, const ReplayResult& r, const std::string& out_dir) {
+void printSummary(const std::string& log, const ReplayResult& r, const std::string& out_dir, bool map_given) {
   std::printf("coloc fuse %s\n", log.c_str());
   std::printf("  %llu messages over %.1f s of log; clock: %s", static_cast<unsigned long long>(r.messages_read), r.log_duration,
               r.clock == ClockMode::kSeparate ? "header stamps and log times on different clocks" : "one clock");
@@ -65,6 +65,8 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
     std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
     std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);
+  } else if (map_given) {
+    std::printf("\n  the map was not used: no topic of the log is a scan (PointCloud2) for NDT to match\n");
   }
   if (!r.errors.empty()) {
     const ErrorStats s = r.errorStats();
@@ -160,7 +162,7 @@ void addFuseCommand(CLI::App& app) {
     if (!result.errors.empty()) result.writeErrorCsv(out_dir + "/error.csv");
     if (!result.input_errors.empty()) result.writeInputErrorCsv(out_dir + "/input_error.csv");
     writePlots(result, out_dir, log);
-    printSummary(log, result, out_dir);
+    printSummary(log, result, out_dir, !options.map.empty());
   });
 }
 

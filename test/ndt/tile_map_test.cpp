@@ -33,6 +33,28 @@ std::string writeTiles(const testing::TempDir& dir, int n) {
   return folder;
 }
 
+// A replay checks the map it is given before anything else, whether or not it will read its tiles.
+TEST(TileMap, CheckPathRefusesAMissingPathAndAFolderWithoutTilesAndReadsNoTile) {
+  testing::TempDir dir;
+  const auto message = [](const std::string& path) {
+    try {
+      TileMap::checkPath(path);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(dir / "nowhere"), dir / "nowhere" + ": no such map file or folder");
+  std::filesystem::create_directories(dir / "empty");
+  std::ofstream(dir / "empty" + "/notes.txt") << "not a tile\n";
+  EXPECT_EQ(message(dir / "empty"), dir / "empty" + ": the map folder holds no .pcd tile");
+  // A folder with a tile passes, even one that would not load: checking reads no tile.
+  std::filesystem::create_directories(dir / "one");
+  std::ofstream(dir / "one" + "/tile.pcd") << "not a PCD\n";
+  EXPECT_EQ(message(dir / "one"), "");
+  EXPECT_EQ(message(writeTiles(dir, 1)), "");
+}
+
 TEST(TileMap, FolderIsIndexedWithEachTilesBounds) {
   testing::TempDir dir;
   const TileMap map = TileMap::open(writeTiles(dir, 3));

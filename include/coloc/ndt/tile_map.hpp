@@ -33,6 +33,9 @@ class TileMap {
   /// A file: one cloud, sliced into tile_size squares kept in memory. Throws coloc::Error naming the
   /// path for a missing, empty or unreadable map.
   static TileMap open(const std::string& path, double tile_size = 20.0);
+  /// What open() checks before reading any tile: the path is a file, or a folder with a *.pcd in it.
+  /// Throws coloc::Error naming the path otherwise.
+  static void checkPath(const std::string& path);
   static TileMap fromCloud(const PointCloud& cloud, double tile_size);
 
   const std::vector<TileInfo>& tiles() const { return tiles_; }
