@@ -41,6 +41,7 @@ void TileMap::checkPath(const std::string& path) {
 TileMap TileMap::open(const std::string& path, double tile_size) {
   namespace fs = std::filesystem;
   std::error_code ec;
+  checkPath(path);
   if (fs::is_regular_file(path, ec)) {
     TileMap map = fromCloud(loadPcd(path), tile_size);
     std::ostringstream id;
@@ -49,11 +50,10 @@ TileMap TileMap::open(const std::string& path, double tile_size) {
     map.id_ = id.str();
     return map;
   }
-  if (!fs::is_directory(path, ec)) throw Error(path + ": no such map file or folder");
-  std::vector<std::string> files;
+  std::vector<std::string> files;  // a folder with at least one tile (checked)
   for (const auto& entry : fs::directory_iterator(path, ec))
     if (entry.is_regular_file() && entry.path().extension() == ".pcd") files.push_back(entry.path().string());
-  if (files.empty()) throw Error(path + ": the map folder holds no .pcd tile");
+  if (files.empty()) throw Error(path + ": the map folder holds no .pcd tile");  // emptied since the check
   std::sort(files.begin(), files.end());  // a stable order, whatever the file system lists
   TileMap map;
   map.id_ = fs::absolute(path, ec).string();
