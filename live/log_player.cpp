@@ -57,7 +57,7 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
 
   PlayReport report;
   const auto wall_start = SteadyClock::now();
-  const Duration clock_period = static_cast<Duration>(1e9 / std::max(options.clock_frequency, 1.0));
+  const Duration clock_period = static_cast<Duration>(1e9 / options.clock_frequency);  // checked: 1 Hz or more
   const std::uint64_t total = std::max<std::uint64_t>(probe.messageCount(), 1);
   for (bool first_pass = true; first_pass || options.loop; first_pass = false) {
     io::BagReader bag = io::BagReader::open(log_path);

@@ -198,9 +198,9 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   po.registry = std::move(registry);
   bool scans = false;
   for (const TopicUse& t : result.topics) scans = scans || t.role == InputRole::kScan;
-  // A map that is not there is an error whether or not the log has scans to match against it; its
-  // tiles are read only when it does.
-  if (!options.map.empty()) ndt::TileMap::checkPath(options.map);
+  // A map that is not there is an error whether or not the log has scans to match against it (opening
+  // it checks its path; without scans it is not opened, its tiles are not read).
+  if (!scans && !options.map.empty()) ndt::TileMap::checkPath(options.map);
   if (scans && !options.map.empty()) {
     po.map = options.cache ? options.cache->map(options.map, options.config.ndt.map_tile_size)
                            : ndt::TileMap::open(options.map, options.config.ndt.map_tile_size);

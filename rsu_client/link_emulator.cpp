@@ -17,9 +17,9 @@ std::string shown(double v) {
   return s.str();
 }
 
-// A delay or loss outside its range would not fail loudly: a negative delay is taken as none, a loss
-// above 1 drops everything, a NaN loss drops nothing.
-void check(const LinkConfig& c) {
+}  // namespace
+
+void checkLinkConfig(const LinkConfig& c) {
   const auto seconds = [](double v, const char* name) {
     if (!(std::isfinite(v) && v >= 0.0)) throw Error(std::string("link: ") + name + " must be a finite number of seconds >= 0 (got " + shown(v) + ")");
   };
@@ -35,9 +35,7 @@ void check(const LinkConfig& c) {
   probability(c.loss_in_bad, "loss_in_bad");
 }
 
-}  // namespace
-
-LinkEmulator::LinkEmulator(const LinkConfig& config) : config_(config), rng_(config.seed) { check(config); }
+LinkEmulator::LinkEmulator(const LinkConfig& config) : config_(config), rng_(config.seed) { checkLinkConfig(config); }
 
 std::optional<Stamp> LinkEmulator::transmit(Stamp sent) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);

@@ -284,6 +284,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const auto wall_start = Clock::now();
   const std::string& out_dir = options.out_dir;
   if (fs::exists(out_dir) && !fs::is_empty(out_dir)) throw Error(out_dir + ": the output folder exists and is not empty");
+  // The options that would otherwise fail only after the survey, or not at all.
+  rsu_client::checkLinkConfig(options.link);
+  if (!(std::isfinite(options.rsu_processing) && options.rsu_processing >= 0.0))
+    throw Error("twin: the RSU's processing time must be a finite number of seconds >= 0");
   fs::create_directories(out_dir);
   TwinRecordingSummary summary;
 

@@ -2,9 +2,12 @@
 // between: they must be, bit for bit, what a replay decodes from the same drive written to disk.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "coloc/core/error.hpp"
 #include "coloc/replay/replay_cache.hpp"
 #include "coloc/sim/scene.hpp"
 #include "coloc/twin/twin_recording.hpp"
@@ -45,6 +48,32 @@ TEST(TwinRecording, ScansKeptInMemoryAreWhatAReplayDecodesFromTheWrittenLog) {
     ++scans;
   }
   EXPECT_GT(scans, 40);  // 60 m at 8 m/s, 10 Hz
+}
+
+// A link or processing time out of range is refused before the drive is surveyed and simulated,
+// naming what is wrong, and nothing is written.
+TEST(TwinRecording, RefusesALinkOrProcessingTimeOutOfRangeBeforeSimulating) {
+  const sim::Scenario scenario = sim::parseScenario("route: {start: [0, 0], pieces: [{length: 50}]}\n", "s.yaml");
+  testing::TempDir dir;
+  const auto message = [&](TwinRecordingOptions options) {
+    options.out_dir = (dir.path() / "drive").string();
+    try {
+      recordTwin(scenario, options);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  TwinRecordingOptions bad_loss;
+  bad_loss.link.loss = 2.0;
+  EXPECT_NE(message(bad_loss).find("link: loss must be a probability in [0, 1]"), std::string::npos);
+  TwinRecordingOptions bad_delay;
+  bad_delay.link.delay = -0.03;
+  EXPECT_NE(message(bad_delay).find("link: delay must be a finite number of seconds >= 0"), std::string::npos);
+  TwinRecordingOptions bad_processing;
+  bad_processing.rsu_processing = std::nan("");
+  EXPECT_NE(message(bad_processing).find("processing time must be a finite number"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "drive" / "map"));  // refused before the survey
 }
 
 }  // namespace

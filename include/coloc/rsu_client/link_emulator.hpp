@@ -23,6 +23,11 @@ struct LinkConfig {
   std::uint64_t seed = 1;
 };
 
+/// Throws coloc::Error naming the field of a delay or jitter that is not a finite number of seconds
+/// >= 0, or of a probability outside [0, 1]: a negative delay would be taken as none, a loss above 1
+/// would drop everything, a NaN one nothing. LinkEmulator's constructor checks its configuration so.
+void checkLinkConfig(const LinkConfig& config);
+
 class LinkEmulator {
  public:
   explicit LinkEmulator(const LinkConfig& config);
