@@ -63,7 +63,10 @@ void mcapSeeds(const fs::path& recording, const fs::path& scratch) {
         }
         writer.close();
       }
-      seed("mcap_fuzzer", "written_" + std::to_string(k++) + ".mcap", readFile(path));
+      const Bytes written = readFile(path);
+      seed("mcap_fuzzer", "written_" + std::to_string(k) + ".mcap", written);
+      // Cut inside a chunk, as a recorder that died leaves a file: the way into recovery.
+      seed("mcap_fuzzer", "cut_" + std::to_string(k++) + ".mcap", Bytes(written.begin(), written.begin() + written.size() * 2 / 3));
     }
   }
 }

@@ -51,10 +51,11 @@ void removePartialOutput(const std::string& output, bool is_mcap, bool directory
 }  // namespace
 
 ConvertSummary convert(const std::string& input, const std::string& output, const ConvertOptions& options) {
-  BagReader reader = BagReader::open(input);
+  BagReader reader = BagReader::open(input, options.read);
   reader.keepAttachments(true);  // copied to an MCAP output, counted for a sqlite3 one
   ConvertSummary summary;
   summary.topics = reader.topics();
+  summary.recovered = reader.recovered();
   const bool is_mcap = endsWith(output, ".mcap");
   std::error_code ec;
   const bool directory_existed = !is_mcap && fs::is_directory(output, ec);

@@ -43,8 +43,8 @@ std::optional<Storage> sniffStorage(const fs::path& path) {
   return std::nullopt;
 }
 
-std::unique_ptr<detail::StorageReader> openStorage(Storage storage, const std::string& path) {
-  return storage == Storage::kMcap ? detail::openMcapStorage(path) : detail::openSqliteStorage(path);
+std::unique_ptr<detail::StorageReader> openStorage(Storage storage, const std::string& path, const BagReadOptions& options) {
+  return storage == Storage::kMcap ? detail::openMcapStorage(path, options.recover) : detail::openSqliteStorage(path);
 }
 
 /// Split files are "<bag>_<N>.<ext>" with N unpadded, so "bag_10" must sort after "bag_9": order by the
@@ -95,6 +95,7 @@ class MessageDecompressing final : public detail::StorageReader {
  public:
   MessageDecompressing(std::unique_ptr<detail::StorageReader> inner, std::string path) : inner_(std::move(inner)), path_(std::move(path)) {}
   const std::vector<TopicInfo>& topics() const override { return inner_->topics(); }
+  std::optional<RecoveredFile> recovery() const override { return inner_->recovery(); }
   bool next(BagMessage& message) override {
     if (!inner_->next(message)) return false;
     message.data = detail::decompressZstdMessage(message.data.data(), message.data.size(),
@@ -208,9 +209,10 @@ struct BagReader::Impl {
   std::uint64_t next_index = 0;
   std::vector<BagAttachment> attachments;
   std::vector<BagMetadataRecord> metadata;
+  std::vector<RecoveredFile> recovered;
 };
 
-BagReader BagReader::open(const std::string& path) {
+BagReader BagReader::open(const std::string& path, const BagReadOptions& options) {
   BagLayout layout = layoutOf(path);
   auto impl = std::make_unique<Impl>();
   impl->path = path;
@@ -225,13 +227,17 @@ BagReader BagReader::open(const std::string& path) {
       if (name.size() > 5 && name.compare(name.size() - 5, 5, ".zstd") == 0) name.resize(name.size() - 5);
       const std::string plain = (impl->decompressed->path() / (std::to_string(impl->readers.size()) + "_" + name)).string();
       detail::decompressZstdFile(file, plain);
-      impl->readers.push_back(openStorage(layout.storage, plain));
+      impl->readers.push_back(openStorage(layout.storage, plain, options));
     } else if (layout.compression == Compression::kMessage) {
-      impl->readers.push_back(std::make_unique<MessageDecompressing>(openStorage(layout.storage, file), file));
+      impl->readers.push_back(std::make_unique<MessageDecompressing>(openStorage(layout.storage, file, options), file));
     } else {
-      impl->readers.push_back(openStorage(layout.storage, file));
+      impl->readers.push_back(openStorage(layout.storage, file, options));
     }
     mergeTopics(impl->topics, impl->readers.back()->topics());
+    if (std::optional<RecoveredFile> recovered = impl->readers.back()->recovery()) {
+      recovered->file = file;  // the bag's file, not a decompressed copy's
+      impl->recovered.push_back(std::move(*recovered));
+    }
   }
   for (auto& topic : impl->topics) {
     impl->message_count += topic.message_count;
@@ -253,6 +259,7 @@ const std::string& BagReader::storageIdentifier() const { return impl_->storage;
 const std::vector<std::string>& BagReader::files() const { return impl_->files; }
 const std::vector<TopicInfo>& BagReader::topics() const { return impl_->topics; }
 std::uint64_t BagReader::messageCount() const { return impl_->message_count; }
+const std::vector<RecoveredFile>& BagReader::recovered() const { return impl_->recovered; }
 void BagReader::keepAttachments(bool keep) {
   for (auto& reader : impl_->readers)
     if (reader) reader->keepAttachments(keep);

@@ -2,6 +2,11 @@
 // open, takes schemas, channels and message counts from the summary section when the file has one
 // (else from one scan of the data section), and then streams the data section record by record,
 // holding at most one decompressed chunk in memory.
+//
+// A file without its closing magic and footer was not closed: its writer stopped (a crash, a power
+// cut) and left it cut, usually inside a chunk. Refused by default; opened to be recovered, its data
+// section is read from the start until a record is cut or unreadable, and the same scan that counts
+// its messages finds that place, so that counts and messages agree.
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -55,14 +60,18 @@ RecordSpan nextBufferedRecord(const std::vector<std::uint8_t>& buffer, std::size
   return span;
 }
 
+// Appended to the errors that mean a file was not closed.
+const char* const kNotClosedHint = " (a recording that was never closed is read up to where it stops with recovery on: --recover)";
+
 class McapReader final : public StorageReader {
  public:
-  explicit McapReader(const std::string& path);
+  McapReader(const std::string& path, bool recover);
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   bool next(BagMessage& message) override;
   void keepAttachments(bool keep) override { keep_attachments_ = keep; }
   std::vector<BagAttachment> takeAttachments() override { return std::move(attachments_); }
   std::vector<BagMetadataRecord> takeMetadata() override { return std::move(metadata_); }
+  std::optional<RecoveredFile> recovery() const override { return recovery_; }
 
  private:
   struct RecordHead {
@@ -78,6 +87,8 @@ class McapReader final : public StorageReader {
   std::string where(const RecordHead& head) const;
 
   void checkMagic(std::uint64_t offset, const char* which);
+  bool looksClosed();
+  bool nextRecord(BagMessage& message);
   Footer readFooter();
   void readHeaderRecord();
   void readSummary(const Footer& footer);
@@ -111,9 +122,15 @@ class McapReader final : public StorageReader {
   std::vector<std::uint8_t> chunk_;    // current decompressed chunk
   std::size_t chunk_position_ = 0;
   std::uint64_t chunk_offset_ = 0;
+
+  // Recovery of a file that was not closed: reading ends, without an error, where a record is cut
+  // or unreadable (the top-level record's offset: a chunk's, for a record inside it).
+  bool cut_ = false;
+  std::uint64_t record_start_ = 0;
+  std::optional<RecoveredFile> recovery_;
 };
 
-McapReader::McapReader(const std::string& path) : path_(path) {
+McapReader::McapReader(const std::string& path, bool recover) : path_(path) {
   file_.open(path, std::ios::binary);
   if (!file_) fail("cannot open the file for reading");
   file_.seekg(0, std::ios::end);
@@ -122,8 +139,25 @@ McapReader::McapReader(const std::string& path) : path_(path) {
     fail("truncated or not an MCAP file: " + std::to_string(file_size_) + " bytes, shorter than the magic");
   }
   checkMagic(0, "leading");
+  if (recover && !looksClosed()) {
+    cut_ = true;
+    data_end_ = file_size_;
+    readHeaderRecord();  // a file cut inside its Header holds nothing to recover: refused
+    recovery_.emplace();
+    recovery_->file = path_;
+    recovery_->file_bytes = file_size_;
+    countMessagesByScanning();
+    for (const TopicInfo& topic : topics_) recovery_->messages += topic.message_count;
+    // The reading starts from where the scan started (the topics stay, with their counts), so that it
+    // stops where the scan did.
+    schemas_.clear();
+    channels_.clear();
+    topic_of_channel_.clear();
+    rewind();
+    return;
+  }
   if (file_size_ < 2 * sizeof kMagic + kFooterRecordSize) {
-    fail("truncated: " + std::to_string(file_size_) + " bytes, too short to hold a Footer and the closing magic");
+    fail("truncated: " + std::to_string(file_size_) + " bytes, too short to hold a Footer and the closing magic" + kNotClosedHint);
   }
   checkMagic(file_size_ - sizeof kMagic, "closing");
   const Footer footer = readFooter();
@@ -146,8 +180,17 @@ void McapReader::checkMagic(std::uint64_t offset, const char* which) {
   if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
     if (offset == 0) fail("not an MCAP file: bad magic at byte offset 0");
     fail(std::string("no ") + which + " MCAP magic at byte offset " + std::to_string(offset) +
-         ": the file is truncated or corrupt");
+         ": the file is truncated or corrupt" + kNotClosedHint);
   }
+}
+
+// A closed file ends with a Footer record and the magic; anything else was cut.
+bool McapReader::looksClosed() {
+  if (file_size_ < 2 * sizeof kMagic + kFooterRecordSize) return false;
+  std::uint8_t tail[kFooterRecordSize + sizeof kMagic];
+  readAt(file_size_ - sizeof tail, tail, sizeof tail);
+  return tail[0] == kFooter && readU64Le(tail + 1) == kFooterContentSize &&
+         std::memcmp(tail + kFooterRecordSize, kMagic, sizeof kMagic) == 0;
 }
 
 Footer McapReader::readFooter() {
@@ -155,7 +198,7 @@ Footer McapReader::readFooter() {
   std::uint8_t bytes[kFooterRecordSize];
   readAt(offset, bytes, sizeof bytes);
   if (bytes[0] != kFooter || readU64Le(bytes + 1) != kFooterContentSize) {
-    fail("no Footer record at byte offset " + std::to_string(offset) + ": the file is truncated or corrupt");
+    fail("no Footer record at byte offset " + std::to_string(offset) + ": the file is truncated or corrupt" + kNotClosedHint);
   }
   RecordCursor cursor(bytes + kRecordPrefixSize, kFooterContentSize, path_ + ": Footer");
   const Footer footer = parseFooter(cursor);
@@ -264,7 +307,7 @@ void McapReader::registerSchema(SchemaRecord schema) {
 }
 
 void McapReader::registerChannel(const ChannelRecord& channel, const std::string& where) {
-  if (!channels_.emplace(channel.id, channel).second) return;
+  if (channels_.count(channel.id)) return;
   TopicInfo info;
   info.name = channel.topic;
   info.serialization_format = channel.message_encoding;
@@ -278,6 +321,7 @@ void McapReader::registerChannel(const ChannelRecord& channel, const std::string
     info.message_definition = schema->second.data;
     info.message_definition_encoding = schema->second.encoding;
   }
+  channels_.emplace(channel.id, channel);  // only once it is known good
   info.metadata = channel.metadata;
   const auto qos = info.metadata.find("offered_qos_profiles");
   if (qos != info.metadata.end()) {
@@ -321,16 +365,42 @@ void McapReader::rewind() {
 }
 
 bool McapReader::next(BagMessage& message) {
+  if (!cut_) return nextRecord(message);
+  if (done_ && chunk_position_ >= chunk_.size()) return false;
+  try {
+    if (nextRecord(message)) return true;
+    if (recovery_->reason.empty()) {
+      recovery_->read_bytes = offset_;
+      recovery_->reason = offset_ < data_end_ ? "the data section is whole (its Data End record ends at byte " + std::to_string(offset_) +
+                                                    "); what follows it (summary, footer) is cut"
+                                              : "the file ends after a whole record, without Data End, summary or footer";
+    }
+  } catch (const Error& e) {
+    // Where the writer stopped: everything from this record on is left unread.
+    done_ = true;
+    std::vector<std::uint8_t>().swap(chunk_);
+    chunk_position_ = 0;
+    if (recovery_->reason.empty()) {
+      recovery_->read_bytes = record_start_;
+      const std::string what = e.what(), prefix = path_ + ": ";
+      recovery_->reason = what.compare(0, prefix.size(), prefix) == 0 ? what.substr(prefix.size()) : what;
+    }
+  }
+  return false;
+}
+
+bool McapReader::nextRecord(BagMessage& message) {
   for (;;) {
     if (chunk_position_ < chunk_.size()) {
       if (nextInChunk(message)) return true;
       continue;
     }
     if (done_) return false;
-    if (offset_ >= data_end_) {  // no Data End record: tolerated, the footer checks passed
+    if (offset_ >= data_end_) {  // no Data End record: tolerated, the footer checks passed (or the file was cut)
       done_ = true;
       return false;
     }
+    record_start_ = offset_;
     const RecordHead head = readRecordHead(offset_, data_end_);
     offset_ = head.offset + kRecordPrefixSize + head.length;
     switch (head.opcode) {
@@ -347,11 +417,18 @@ bool McapReader::next(BagMessage& message) {
       }
       case kAttachment:
       case kMetadata: {
-        if (!keep_attachments_) break;  // a replay has no use for them: not even read
+        // A replay has no use for them: not even read, unless the file was cut, where an unreadable one
+        // ends what is read whether or not it is kept (the counting scan keeps none).
+        if (!keep_attachments_ && !cut_) break;
         loadContent(head);
         RecordCursor cursor(content_.data(), content_.size(), where(head));
-        if (head.opcode == kAttachment) attachments_.push_back(parseAttachment(cursor));
-        else metadata_.push_back(parseMetadata(cursor));
+        if (head.opcode == kAttachment) {
+          BagAttachment attachment = parseAttachment(cursor);
+          if (keep_attachments_) attachments_.push_back(std::move(attachment));
+        } else {
+          BagMetadataRecord metadata = parseMetadata(cursor);
+          if (keep_attachments_) metadata_.push_back(std::move(metadata));
+        }
         break;
       }
       case kDataEnd:
@@ -430,6 +507,8 @@ bool McapReader::nextInChunk(BagMessage& message) {
 
 }  // namespace
 
-std::unique_ptr<StorageReader> openMcapStorage(const std::string& path) { return std::make_unique<McapReader>(path); }
+std::unique_ptr<StorageReader> openMcapStorage(const std::string& path, bool recover) {
+  return std::make_unique<McapReader>(path, recover);
+}
 
 }  // namespace coloc::io::detail

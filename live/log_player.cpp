@@ -34,7 +34,7 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
   if (!(options.clock_frequency >= 1.0 && options.clock_frequency <= 1e4))
     throw Error("play: the clock frequency must be a number of Hz in [1, 10000]");
   if (!(std::isfinite(options.delay) && options.delay >= 0.0)) throw Error("play: the delay before the first message must be a finite number of seconds >= 0");
-  io::BagReader probe = io::BagReader::open(log_path);
+  io::BagReader probe = io::BagReader::open(log_path, io::BagReadOptions{options.recover});
   for (const std::string& wanted : options.topics) {
     const auto& all = probe.topics();
     if (std::none_of(all.begin(), all.end(), [&](const io::TopicInfo& t) { return t.name == wanted; }))
@@ -56,11 +56,12 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
   if (options.delay > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(options.delay));
 
   PlayReport report;
+  report.recovered = probe.recovered();
   const auto wall_start = SteadyClock::now();
   const Duration clock_period = static_cast<Duration>(1e9 / options.clock_frequency);  // checked: 1 Hz or more
   const std::uint64_t total = std::max<std::uint64_t>(probe.messageCount(), 1);
   for (bool first_pass = true; first_pass || options.loop; first_pass = false) {
-    io::BagReader bag = io::BagReader::open(log_path);
+    io::BagReader bag = io::BagReader::open(log_path, io::BagReadOptions{options.recover});
     io::BagMessage message;
     bool started = false;
     Stamp log_start = 0, last_clock = 0, last_log = 0;

@@ -274,9 +274,10 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   std::optional<io::BagReader> bag;
   std::shared_ptr<const RecordedLog> recorded;
   if (options.cache) recorded = options.cache->log(log_path);
-  else bag.emplace(io::BagReader::open(log_path));
+  else bag.emplace(io::BagReader::open(log_path, io::BagReadOptions{options.recover}));
   const std::vector<io::TopicInfo>& log_topics = recorded ? recorded->topics() : bag->topics();
   ReplayResult result;
+  if (bag) result.recovered = bag->recovered();
   result.topics = planTopics(log_topics, config, !options.map.empty(), registry ? &*registry : nullptr, result.rejections);
   const bool has_input = std::any_of(result.topics.begin(), result.topics.end(), [](const TopicUse& t) {
     return t.role == InputRole::kPose || t.role == InputRole::kTwist || t.role == InputRole::kScan || t.role == InputRole::kRsuFix;

@@ -8,6 +8,7 @@
 
 #include "coloc/core/error.hpp"
 #include "error_json.hpp"
+#include "recovered_json.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 
 namespace coloc::replay {
@@ -180,6 +181,7 @@ rsu_client::RsuRegistry SmoothResult::calibratedRegistry() const {
 std::string SmoothResult::summaryJson(const std::string& log) const {
   nlohmann::ordered_json j;
   j["log"] = log;
+  if (!filter.recovered.empty()) j["recovered"] = recoveredJson(filter.recovered);
   j["smoothed"] = {{"file", "smoothed.tum"}, {"states", smoothed.size()}};
   j["position_error"] = errorJson(errors, "error.csv");
   j["filter_position_error"] = errorJson(filter_errors_matched, "error.csv");

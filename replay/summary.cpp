@@ -12,6 +12,7 @@
 #include "coloc/replay/log_replay.hpp"
 #include "coloc/pipeline/report_json.hpp"
 #include "error_json.hpp"
+#include "recovered_json.hpp"
 
 namespace coloc::replay {
 
@@ -19,6 +20,7 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
   nlohmann::ordered_json j;
   j["log"] = log;
   j["messages"] = messages_read;
+  if (!recovered.empty()) j["recovered"] = recoveredJson(recovered);  // only then: a closed log's summary is as it always was
   j["log_duration_s"] = log_duration;
   j["clock"] = {{"mode", clock == ClockMode::kSeparate ? "separate" : "same"}};
   if (clock == ClockMode::kSeparate) {

@@ -22,6 +22,7 @@ using namespace coloc::replay;
 
 void printSummary(const std::string& log, const ReplayResult& r, const std::string& out_dir, bool map_given) {
   std::printf("coloc fuse %s\n", log.c_str());
+  if (!r.recovered.empty()) std::printf("%s", describeRecovered(r.recovered).c_str());
   std::printf("  %llu messages over %.1f s of log; clock: %s", static_cast<unsigned long long>(r.messages_read), r.log_duration,
               r.clock == ClockMode::kSeparate ? "header stamps and log times on different clocks" : "one clock");
   if (r.clock == ClockMode::kSeparate)

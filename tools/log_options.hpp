@@ -11,6 +11,7 @@ namespace coloc::tools {
 struct LogOptions {
   std::string log, config, map, registry;
   std::string out;  ///< its default is set before addLogOptions
+  bool recover = false;
 };
 
 void addLogOptions(CLI::App* cmd, LogOptions& o);
@@ -18,5 +19,9 @@ void addLogOptions(CLI::App* cmd, LogOptions& o);
 replay::ReplayOptions replayOptions(const LogOptions& o);
 /// Creates the output folder or throws coloc::Error saying why not.
 void createOutputFolder(const std::string& dir);
+/// The --recover flag, as every command that reads a log words it.
+CLI::Option* addRecoverFlag(CLI::App* cmd, bool& recover);
+/// One line per file read up to its cut, indented, for the terminal.
+std::string describeRecovered(const std::vector<io::RecoveredFile>& recovered);
 
 }  // namespace coloc::tools

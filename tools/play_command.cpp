@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "number_checks.hpp"
 #include "dds_options.hpp"
+#include "log_options.hpp"
 #include "progress.hpp"
 #include "teardown_watchdog.hpp"
 
@@ -32,6 +33,7 @@ void addPlayCommand(CLI::App& app) {
   cmd->add_flag("--no-clock", no_clock, "do not publish the log's time on /clock");
   cmd->add_option("--clock-frequency", options.clock_frequency, "Hz of /clock between messages")->check(finiteNumber(1.0, 10000.0))->capture_default_str();
   cmd->add_option("--delay", options.delay, "seconds to wait before the first message, for discovery")->check(finiteNumber(0.0, 3600.0))->capture_default_str();
+  addRecoverFlag(cmd, options.recover);
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
   addDdsOptions(cmd, dds);
   cmd->callback([] {
@@ -52,6 +54,7 @@ void addPlayCommand(CLI::App& app) {
     std::printf("played %llu messages of %.1f s of log in %.1f s%s (latest %.1f ms behind its time)%s\n", (unsigned long long)total,
                 r.log_seconds, r.wall_seconds, r.loops > 1 ? (", " + std::to_string(r.loops) + " passes").c_str() : "", r.max_lag_ms,
                 r.stopped ? ", stopped on a signal" : "");
+    std::printf("%s", describeRecovered(r.recovered).c_str());
     for (const auto& [topic, n] : r.published) std::printf("  %-40s %llu\n", topic.c_str(), (unsigned long long)n);
     if (r.failed) std::printf("  %llu writes refused by DDS\n", (unsigned long long)r.failed);
   });

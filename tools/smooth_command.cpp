@@ -99,7 +99,9 @@ void addSmoothCommand(CLI::App& app) {
       for (const ErrorSample& e : r.errors) csv << formatSeconds(e.stamp) << ",smoother," << e.error << "," << e.along << "," << e.across << "\n";
       writeErrorPlot(r, out_dir + "/error.svg");
     }
-    std::printf("coloc smooth %s\n  %d states, %d pose and %d twist residuals; Ceres: %s\n", log.c_str(), r.summary.states,
+    std::printf("coloc smooth %s\n", log.c_str());
+    if (!r.filter.recovered.empty()) std::printf("%s", describeRecovered(r.filter.recovered).c_str());
+    std::printf("  %d states, %d pose and %d twist residuals; Ceres: %s\n", r.summary.states,
                 r.summary.pose_residuals, r.summary.twist_residuals, r.summary.report.c_str());
     std::printf("  smoothed %.1f s of log in %.2f s (solver %.2f s); %zu measurements down-weighted by the robust loss\n",
                 toSeconds(r.smoothed.back().stamp - r.smoothed.front().stamp), r.wall_seconds, r.summary.seconds,

@@ -13,6 +13,7 @@
 
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_reader.hpp"
+#include "coloc/io/mcap_writer.hpp"
 
 namespace coloc::io::testing {
 
@@ -22,6 +23,17 @@ namespace fs = std::filesystem;
 inline std::string nav2Bag() {
   const std::string path = COLOC_DATA_DIR "/rosbag2/nav2_turtlebot.mcap";
   if (!fs::is_regular_file(path)) throw std::runtime_error("real data file missing: " + path + " (see data/README.md)");
+  return path;
+}
+
+/// The first `messages` of the real recording, written to `path` by coloc's MCAP writer with `options`.
+inline std::string rewriteNav2(const std::string& path, const McapWriterOptions& options, std::size_t messages) {
+  BagReader reader = BagReader::open(nav2Bag());
+  McapWriter writer = McapWriter::create(path, options);
+  for (const auto& topic : reader.topics()) writer.addTopic(topic);
+  BagMessage message;
+  for (std::size_t i = 0; i < messages && reader.next(message); ++i) writer.write(message);
+  writer.close();
   return path;
 }
 

@@ -71,16 +71,9 @@ std::string writeFile(const ScratchDir& dir, const std::string& name, const std:
 
 /// A small MCAP file of real messages, written by coloc with the given compression and CRCs.
 std::string smallRecording(const ScratchDir& dir, McapCompression compression, std::size_t messages = 60) {
-  const std::string path = dir / ("small_" + std::to_string(static_cast<int>(compression)) + ".mcap");
-  BagReader reader = BagReader::open(nav2Bag());
   McapWriterOptions options;
   options.compression = compression;
-  McapWriter writer = McapWriter::create(path, options);
-  for (const auto& topic : reader.topics()) writer.addTopic(topic);
-  BagMessage message;
-  for (std::size_t i = 0; i < messages && reader.next(message); ++i) writer.write(message);
-  writer.close();
-  return path;
+  return testing::rewriteNav2(dir / ("small_" + std::to_string(static_cast<int>(compression)) + ".mcap"), options, messages);
 }
 
 /// Offset of the first Chunk record (right after magic and Header).

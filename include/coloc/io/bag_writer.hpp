@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "coloc/io/bag_message.hpp"
+#include "coloc/io/bag_reader.hpp"
 #include "coloc/io/mcap_writer.hpp"
 
 namespace coloc::io {
@@ -47,6 +48,9 @@ class BagWriter {
 struct ConvertOptions {
   McapWriterOptions mcap;  ///< used when the output is a .mcap file
   BagCompression sqlite_compression = BagCompression::kNone;  ///< used when the output is a sqlite3 bag
+  /// Read an input that was never closed up to where it stops: the output is then a closed recording
+  /// of what it held.
+  BagReadOptions read;
 };
 
 struct ConvertSummary {
@@ -54,6 +58,7 @@ struct ConvertSummary {
   std::uint64_t message_count = 0;
   /// MCAP attachments and metadata records read: copied to an MCAP output, which rosbag2 sqlite3 cannot hold.
   std::uint64_t attachments = 0, metadata_records = 0;
+  std::vector<RecoveredFile> recovered;  ///< the input's files read up to their cut (ConvertOptions::read)
 };
 
 /// Copies every message of `input` (anything BagReader::open accepts) to `output`: an MCAP file if the

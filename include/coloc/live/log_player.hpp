@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/io/bag_reader.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 
 namespace coloc::live {
@@ -20,6 +21,7 @@ struct PlayOptions {
   bool publish_clock = true;         ///< the log's time on /clock (rosgraph_msgs/Clock)
   double clock_frequency = 100.0;    ///< Hz of /clock between messages (each message also sends its own time first)
   double delay = 0.0;                ///< s to wait after the writers are created (discovery) before the first message
+  bool recover = false;              ///< play a log that was never closed up to where it stops (io::BagReadOptions)
   rsu_client::DdsConfig dds;
   std::function<bool()> stop_requested;            ///< polled between messages
   std::function<void(double fraction)> progress;   ///< share of the log played
@@ -32,6 +34,7 @@ struct PlayReport {
   double log_seconds = 0.0, wall_seconds = 0.0;
   double max_lag_ms = 0.0;                         ///< latest a message went out after its due time
   bool stopped = false;                            ///< stop_requested ended it
+  std::vector<io::RecoveredFile> recovered;        ///< the log's files that were never closed, played up to their cut
 };
 
 /// Throws coloc::Error if the log cannot be opened, a topic asked for is not in it, or DDS refuses.

@@ -53,6 +53,8 @@ struct ReplayResult {
   double log_duration = 0.0;                       ///< s of log time
   double wall_seconds = 0.0;                       ///< replay time, decoding included
   std::uint64_t messages_read = 0;
+  /// The log's files that were never closed, read up to their cut (ReplayOptions::recover).
+  std::vector<io::RecoveredFile> recovered;
   std::vector<std::string> rejections;             ///< the first few rejection messages, for the summary
   bool ndt_used = false;
   ndt::NdtPoseSourceCounters ndt;                  ///< scan matching, when a map was given
@@ -94,6 +96,9 @@ struct ReplayOptions {
   bool keep_filter_inputs = false;  ///< fill filter_poses, filter_twists and fused_states
   /// Shared with other replays of the same log or map: read, decode and build once (same results).
   std::shared_ptr<ReplayCache> cache;
+  /// Read a log that was never closed (an MCAP file without its footer) up to where it stops, instead
+  /// of refusing it; ReplayResult::recovered says what was read.
+  bool recover = false;
 };
 
 /// Throws coloc::Error if the log cannot be read at all; bad messages inside it are counted, not fatal.
