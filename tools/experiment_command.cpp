@@ -66,6 +66,7 @@ void addExperimentCommand(CLI::App& app) {
     const ExperimentResults results = runExperiment(config, out_dir, progress);
     const std::string table = writeExperimentReport(results, out_dir, command_line);
     std::printf("\nTable I: error within coverage (NDT only against NDT + RSU fusion)\n\n%s\n", table.c_str());
+    for (const std::string& note : results.notes) std::printf("note: %s\n", note.c_str());
     std::printf("finished in %.0f s; tables, figures and CSVs in %s/ (README.md puts them together)\n", results.timing.total, out_dir.c_str());
   });
 }

@@ -53,6 +53,22 @@ std::string slug(const std::string& text, const char* separator = "") {
 
 std::string rsuIdFor(const sim::ScenarioRsu& rsu, const std::string& lidar) { return rsu.id + "_" + slug(lidar); }
 
+// The site's RSU a mounted sensor stands at: its id without the LiDAR's suffix.
+std::string siteRsuId(const sim::ScenarioRsu& mounted) {
+  const std::string suffix = "_" + slug(mounted.lidar_model);
+  const std::string& id = mounted.id;
+  return id.size() > suffix.size() && id.compare(id.size() - suffix.size(), suffix.size(), suffix) == 0 ? id.substr(0, id.size() - suffix.size()) : id;
+}
+
+// How the report names a mounted sensor: "SITE LIDAR", and the RSU's id when the site has several.
+std::string reportKey(const sim::Scenario& scenario, const sim::ScenarioRsu& mounted) {
+  const auto same_model = std::count_if(scenario.rsus.begin(), scenario.rsus.end(),
+                                        [&](const sim::ScenarioRsu& r) { return r.lidar_model == mounted.lidar_model; });
+  std::string key = scenario.name + " " + mounted.lidar_model;
+  if (same_model > 1) key += " (" + siteRsuId(mounted) + ")";
+  return key;
+}
+
 // The site's scenario with every compared LiDAR model mounted at each of its RSUs (one virtual sensor
 // each: they do not disturb one another, so one drive serves all).
 sim::Scenario siteScenario(const std::string& site, const ExperimentConfig& config) {
@@ -110,13 +126,13 @@ struct Job {
   std::shared_ptr<replay::ReplayCache> cache;  ///< shared by the drive's replays
   pipeline::Config config;
   std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSU, its fixes through the registry's checks
-  std::string fix_topic;  ///< the fused RSU topic, empty for NDT only
+  std::vector<std::string> fix_topics;  ///< the fused RSUs' topics (every RSU of the LiDAR model), none for NDT only
   std::vector<Eigen::Vector2d> rsu_positions;
   bool smooth = false;     ///< also smooth the log: `smoothed`
   bool calibrate = false;  ///< smooth with the RSU's calibration: `calibrated`
   std::optional<ExperimentRun> smoothed;
-  std::optional<smoother::RsuCalibration> calibration;
-  std::optional<rsu_client::RsuInfo> calibrated;  ///< the registry entry with the calibration found
+  std::map<std::string, smoother::RsuCalibration> calibrations;  ///< per RSU id, with `calibrate`
+  std::optional<rsu_client::RsuRegistry> calibrated;  ///< the registry with the calibrations found
 };
 
 // A replay's configuration beside the recorded drive, as `coloc fuse` takes it: the same log, map,
@@ -169,9 +185,8 @@ void runJob(Job& job) {
     so.calibrate_rsus = job.calibrate;
     replay::SmoothResult s = replay::smoothLog(job.log, so);
     if (job.calibrate && job.registry) {
-      for (const auto& [id, c] : s.calibrations) job.calibration = c;
-      const std::vector<rsu_client::RsuInfo> rsus = s.calibratedRegistry().rsus();
-      if (!rsus.empty()) job.calibrated = rsus.front();
+      job.calibrations = s.calibrations;
+      job.calibrated = s.calibratedRegistry();
     }
     if (job.smooth) {
       ExperimentRun run = job.run;  // before its errors are filled in
@@ -186,13 +201,14 @@ void runJob(Job& job) {
   }
   fillRun(job.run, r.ground_truth, r.errors, job.rsu_positions);
   if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) job.run.ndt = c->second;
+  const auto fused = [&](const std::string& topic) { return std::find(job.fix_topics.begin(), job.fix_topics.end(), topic) != job.fix_topics.end(); };
   for (const fusion::SourceReport& s : r.sources)
-    if (!job.fix_topic.empty() && s.name == job.fix_topic) {
-      job.run.fixes_applied = s.counters.applied;
-      job.run.fixes_gated = s.counters.gated;
+    if (fused(s.name)) {
+      job.run.fixes_applied += s.counters.applied;
+      job.run.fixes_gated += s.counters.gated;
     }
   for (const replay::TopicUse& t : r.topics)
-    if (t.topic == job.fix_topic) job.run.fixes_lost = t.link_dropped;
+    if (fused(t.topic)) job.run.fixes_lost += t.link_dropped;
   job.run.replay_seconds = r.wall_seconds;
 }
 
@@ -223,13 +239,15 @@ void runJobs(std::vector<Job>& jobs, int threads) {
 // covariance, as a calibration drive past the RSU would give it. Robust (from the median absolute
 // error, as for a normal distribution), because a few gross misfits - the fit on the wrong corner -
 // are the gate's business, not the covariance's.
-double robustFixVariance(const std::vector<Eigen::Vector2d>& errors, const std::string& rsu_id) {
+// None from fewer than kFewestFixes fixes (an RSU the drive hardly passes).
+constexpr std::size_t kFewestFixes = 5;
+std::optional<double> robustFixVariance(const std::vector<Eigen::Vector2d>& errors) {
+  if (errors.size() < kFewestFixes) return std::nullopt;
   std::vector<double> abs_errors;
   for (const Eigen::Vector2d& e : errors) {
     abs_errors.push_back(std::abs(e.x()));
     abs_errors.push_back(std::abs(e.y()));
   }
-  if (abs_errors.size() < 10) throw Error("RSU " + rsu_id + ": too few fixes on the calibration drive to estimate their variance");
   std::nth_element(abs_errors.begin(), abs_errors.begin() + abs_errors.size() / 2, abs_errors.end());
   const double sigma = 1.4826 * abs_errors[abs_errors.size() / 2];
   return sigma * sigma;
@@ -238,8 +256,8 @@ double robustFixVariance(const std::vector<Eigen::Vector2d>& errors, const std::
 // The fixes' variance per axis as the filter gets them: the mean square, tails included. A calibrated
 // RSU's fixes are a centimetre or better with tails of several (a real body's curves, a few points at
 // the edge of a beam gap); a median-based figure describes the core and the filter then follows the tails.
-double meanSquareFixVariance(const std::vector<Eigen::Vector2d>& errors, const std::string& rsu_id) {
-  if (errors.size() < 5) throw Error("RSU " + rsu_id + ": too few fixes on the calibration drive to estimate their variance");
+std::optional<double> meanSquareFixVariance(const std::vector<Eigen::Vector2d>& errors) {
+  if (errors.size() < kFewestFixes) return std::nullopt;
   double sum = 0.0;
   for (const Eigen::Vector2d& e : errors) sum += e.squaredNorm();
   return sum / (2.0 * static_cast<double>(errors.size()));
@@ -332,9 +350,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       drives.push_back({s, kNextTrial, kNextMiscalibrated, 0.0, 0.0});
       drives.push_back({s, kNextTrial, kNextPerfect, 0.0, 0.0});
     }
-  // Per site and LiDAR, the registry entry the calibration drive found, and the one the noise
+  // Per site and LiDAR, the registry the calibration drive found; per site and RSU, the entry the noise
   // calibration drive found (commissioning), which the evaluated drives use.
-  std::map<std::pair<std::size_t, std::string>, rsu_client::RsuInfo> calibrated_entries, commissioned;
+  std::map<std::pair<std::size_t, std::string>, rsu_client::RsuRegistry> calibrated_registries;
+  std::map<std::pair<std::size_t, std::string>, rsu_client::RsuInfo> commissioned;
 
   std::vector<sim::Scenario> scenarios;
   std::vector<std::string> maps(config.sites.size());
@@ -477,8 +496,19 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     // results as apart).
     auto cache = std::make_shared<replay::ReplayCache>(site_targets[drive.site]);
     cache->add(rec.out_dir + "/log", summary.log);
-    auto makeJob = [&](const std::string& lidar, double delay, double loss, const std::string& job_variant,
-                       std::optional<double> variance) {
+    // The fixes' variance under each way of setting it; the estimate comes from the site's noise calibration
+    // drive (none for an RSU that sent too few fixes there: its fixes keep the covariance they carry).
+    auto varianceFor = [&](RsuCovariance how, const sim::ScenarioRsu& r) -> std::optional<double> {
+      const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
+      if (how == RsuCovariance::kStandardDeviation) return model->sigma * model->sigma;
+      if (how == RsuCovariance::kEstimated) {
+        const auto& measured = measured_variance[drive.site];
+        if (const auto found = measured.find(r.id); found != measured.end()) return found->second;
+      }
+      return std::nullopt;  // the fix's own covariance, as published
+    };
+    // NDT with every RSU of the LiDAR model `lidar` at the site (none: NDT only).
+    auto makeJob = [&](const std::string& lidar, double delay, double loss, const std::string& job_variant, RsuCovariance how) {
       Job job;
       job.run.site = scenario.name;
       job.run.trial = drive.trial;
@@ -506,61 +536,53 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         twist.covariance_diagonal = diagonal;
         job.config.inputs["/vehicle/twist"] = twist;
       }
+      std::vector<rsu_client::RsuInfo> fused;
       for (const sim::ScenarioRsu& r : scenario.rsus) {
         pipeline::InputConfig input;
         const std::string topic = rsu_client::fixTopic(r.id);
         if (r.lidar_model == lidar) {
           // The fixes pass the same checks as fixes over DDS; the registry carries the variance chosen.
           input.role = pipeline::InputRole::kRsuFix;
-          job.fix_topic = topic;
+          job.fix_topics.push_back(topic);
           rsu_client::RsuInfo info = registryEntry(r);
-          info.calibrated_variance = variance;
+          info.calibrated_variance = varianceFor(how, r);
           const bool same_installation = drive.variant.empty() || drive.variant == "RSU height" || drive.variant == "speed";
-          if (const auto c = commissioned.find({drive.site, lidar}); same_installation && c != commissioned.end())
+          if (const auto c = commissioned.find({drive.site, r.id}); same_installation && c != commissioned.end())
             info.calibration = c->second.calibration;
-          job.registry = rsu_client::RsuRegistry({info}, rsu_client::CovariancePlacement::kPublished);
           if (delay > 0.0 || loss > 0.0) {
             rsu_client::LinkConfig link;
             link.delay = delay;
             link.loss = loss;
-            link.seed = 7919 * (drive.trial + 1) + static_cast<std::uint64_t>(std::llround(delay * 1e4 + loss * 1e2));
+            // Each RSU's link its own draws (the first RSU's as with one RSU per site).
+            link.seed = 7919 * (drive.trial + 1) + static_cast<std::uint64_t>(std::llround(delay * 1e4 + loss * 1e2)) + 104729 * fused.size();
             input.link = link;
           }
+          fused.push_back(info);
         }
         job.config.inputs[topic] = input;
       }
+      if (!fused.empty()) job.registry = rsu_client::RsuRegistry(fused, rsu_client::CovariancePlacement::kPublished);
       return job;
-    };
-    // The fixes' variance under each way of setting it; the estimate comes from the site's noise calibration drive.
-    auto varianceFor = [&](RsuCovariance how, const std::string& lidar) -> std::optional<double> {
-      const rsu_client::LidarModel* model = rsu_client::findLidarModel(lidar);
-      if (how == RsuCovariance::kStandardDeviation) return model->sigma * model->sigma;
-      if (how == RsuCovariance::kEstimated) {
-        const auto& measured = measured_variance[drive.site];
-        for (const sim::ScenarioRsu& r : scenario.rsus)
-          if (r.lidar_model == lidar) {
-            const auto found = measured.find(r.id);
-            if (found == measured.end()) throw Error("RSU " + r.id + ": no fix variance measured on the noise calibration drive");
-            return found->second;
-          }
-      }
-      return std::nullopt;  // the fix's own covariance, as published
     };
     const RsuCovariance main_covariance = config.rsu_covariance;
     std::vector<Job> jobs;
     if (drive.variant == kNoiseCalibrationDrive) {
       for (const sim::ScenarioRsu& r : scenario.rsus) {
         const auto errors = summary.fix_errors.find(r.id);
-        measured_variance[drive.site][r.id] =
-            robustFixVariance(errors == summary.fix_errors.end() ? std::vector<Eigen::Vector2d>{} : errors->second, r.id);
-        results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
+        const std::size_t fixes = errors == summary.fix_errors.end() ? 0 : errors->second.size();
+        if (const auto v = robustFixVariance(fixes ? errors->second : std::vector<Eigen::Vector2d>{})) {
+          measured_variance[drive.site][r.id] = *v;
+          results.estimated_variance[reportKey(scenario, r)] = *v;
+        } else {
+          results.notes.push_back(reportKey(scenario, r) + ": " + std::to_string(fixes) + " fixes on the noise calibration drive, too few (" +
+                                  std::to_string(kFewestFixes) + ") to estimate their variance: they keep the covariance they are sent with");
+        }
       }
       twist_variance[drive.site] = odometryVariance(summary.odometry, scenario.name);
       // NDT alone on this drive, against ground truth: its covariance for the evaluated drives.
-      if (config.ndt_covariance != NdtCovarianceSource::kPublished) jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
+      if (config.ndt_covariance != NdtCovarianceSource::kPublished) jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
       for (const sim::ScenarioRsu& r : scenario.rsus)
-        if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end())
-          results.ideal_comparison[scenario.name + " " + r.lidar_model] = f->second;
+        if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end()) results.ideal_comparison[reportKey(scenario, r)] = f->second;
       results.estimated_twist_variance[scenario.name] = twist_variance[drive.site];
       if (config.calibrate_rsus)
         for (const sim::ScenarioRsu& r : scenario.rsus) {
@@ -574,60 +596,64 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           Commissioning c;
           c.site = scenario.name;
           c.lidar = r.lidar_model;
+          c.rsu = siteRsuId(r);
           c.dx = r.survey_error.x(), c.dy = r.survey_error.y(), c.dyaw = r.survey_error.z(), c.clock_offset = r.clock_offset;
           c.found = rsu_client::commissionRsu(entry.position, samples);
           results.commissioning.push_back(c);
           if (!c.found.determined) continue;
           rsu_client::RsuInfo calibrated = entry;
           calibrated.calibration = c.found.calibration;
-          commissioned[{drive.site, r.lidar_model}] = calibrated;
+          commissioned[{drive.site, r.id}] = calibrated;
           // The fixes' variance as the filter will see them: calibrated, against where the vehicle was at
           // their (corrected) stamps.
-          const std::vector<Eigen::Vector2d>& corrected = c.found.residuals;
-          measured_variance[drive.site][r.id] = meanSquareFixVariance(corrected, r.id);
-          results.estimated_variance[scenario.name + " " + r.lidar_model] = measured_variance[drive.site][r.id];
+          if (const auto v = meanSquareFixVariance(c.found.residuals)) {
+            measured_variance[drive.site][r.id] = *v;
+            results.estimated_variance[reportKey(scenario, r)] = *v;
+          }
         }
     } else if (drive.variant.empty()) {
       for (const sim::ScenarioRsu& r : scenario.rsus)
         if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end()) {
-          auto& all = results.rsu_frames[scenario.name + " " + r.lidar_model];
+          auto& all = results.rsu_frames[scenario.name + " " + r.lidar_model];  // every RSU of the model together
           all.insert(all.end(), f->second.begin(), f->second.end());
         }
-      jobs.push_back(makeJob("", 0.0, 0.0, "", std::nullopt));
+      jobs.push_back(makeJob("", 0.0, 0.0, "", main_covariance));
       for (const std::string& lidar : config.lidars) {
         for (double delay : config.delays)
           for (double loss : config.losses)
             if ((delay == 0.0 && loss == 0.0) || (config.network && drive.trial < config.network_trials))
-              jobs.push_back(makeJob(lidar, delay, loss, "", varianceFor(main_covariance, lidar)));
+              jobs.push_back(makeJob(lidar, delay, loss, "", main_covariance));
       }
       // Table I compares with a second covariance on every trial; the sweeps add the third.
       const RsuCovariance reference = referenceCovariance(main_covariance);
       for (const std::string& lidar : config.lidars) {
-        jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(reference), varianceFor(reference, lidar)));
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(reference), reference));
         if (config.sweeps && drive.trial < config.sweep_trials)
           for (RsuCovariance how : {RsuCovariance::kPublished, RsuCovariance::kStandardDeviation, RsuCovariance::kEstimated})
             if (how != main_covariance && how != reference)
-              jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(how), varianceFor(how, lidar)));
+              jobs.push_back(makeJob(lidar, 0.0, 0.0, std::string("covariance ") + toString(how), how));
       }
     } else if (drive.variant == kCalibrationDrive) {
       for (const std::string& lidar : config.lidars) {
-        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));
         jobs.back().calibrate = true;
       }
     } else if (drive.variant == kNextMiscalibrated) {
       for (const std::string& lidar : config.lidars) {
-        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
-        const auto found = calibrated_entries.find({drive.site, lidar});
-        if (found == calibrated_entries.end()) continue;
-        Job calibrated = makeJob(lidar, 0.0, 0.0, kNextCalibrated, varianceFor(main_covariance, lidar));
-        rsu_client::RsuInfo info = calibrated.registry->rsus().front();
-        info.calibration = found->second.calibration;
-        calibrated.registry = rsu_client::RsuRegistry({info}, rsu_client::CovariancePlacement::kPublished);
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));
+        const auto found = calibrated_registries.find({drive.site, lidar});
+        if (found == calibrated_registries.end()) continue;
+        // Each RSU with the calibration the calibration drive found for it, where it found one.
+        Job calibrated = makeJob(lidar, 0.0, 0.0, kNextCalibrated, main_covariance);
+        std::vector<rsu_client::RsuInfo> rsus = calibrated.registry->rsus();
+        for (rsu_client::RsuInfo& info : rsus)
+          if (const rsu_client::RsuInfo* c = found->second.find(info.id)) info.calibration = c->calibration;
+        calibrated.registry = rsu_client::RsuRegistry(rsus, rsu_client::CovariancePlacement::kPublished);
         jobs.push_back(std::move(calibrated));
       }
     } else {
-      if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, std::nullopt));
-      for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, varianceFor(main_covariance, lidar)));
+      if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
+      for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));
     }
     // Table I's smoother column: the NDT-only replay and each LiDAR's on the ideal network.
     if (drive.variant.empty() && config.smoother)
@@ -644,17 +670,24 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
         continue;  // never evaluated
       }
-      if (j.calibrate) {
-        CalibrationResult c;
-        c.site = scenario.name;
-        c.lidar = j.run.lidar;
-        c.dx = config.calibration_error[0], c.dy = config.calibration_error[1];
-        c.dyaw = config.calibration_error[2] * M_PI / 180.0;
-        c.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
-        if (j.calibration) c.found = *j.calibration;
-        else c.found.note = "no fix of this RSU on the drive";
-        results.calibrations.push_back(c);
-        if (j.calibrated && j.calibrated->calibration) calibrated_entries[{drive.site, j.run.lidar}] = *j.calibrated;
+      if (j.calibrate && j.registry) {
+        bool any = false;
+        for (const rsu_client::RsuInfo& info : j.registry->rsus()) {
+          CalibrationResult c;
+          c.site = scenario.name;
+          c.lidar = j.run.lidar;
+          c.rsu = info.id;
+          for (const sim::ScenarioRsu& r : scenario.rsus)
+            if (r.id == info.id) c.rsu = siteRsuId(r);
+          c.dx = config.calibration_error[0], c.dy = config.calibration_error[1];
+          c.dyaw = config.calibration_error[2] * M_PI / 180.0;
+          c.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
+          if (const auto found = j.calibrations.find(info.id); found != j.calibrations.end()) c.found = found->second;
+          else c.found.note = "no fix of this RSU on the drive";
+          results.calibrations.push_back(c);
+          if (const rsu_client::RsuInfo* calibrated = j.calibrated ? j.calibrated->find(info.id) : nullptr) any = any || calibrated->calibration.has_value();
+        }
+        if (any) calibrated_registries.emplace(std::make_pair(drive.site, j.run.lidar), *j.calibrated);
       }
       if (j.smoothed) {
         results.timing.replay += j.smoothed->replay_seconds;

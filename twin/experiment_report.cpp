@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <cstdlib>
 #include <tuple>
@@ -217,11 +218,21 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     if (!smoother_md.str().empty()) writeFile(out_dir + "/smoother.csv", csv.str());
   }
 
+  // A LiDAR model's row names its RSU where the site has several of that model.
+  const auto withRsu = [&](const std::string& site, const std::string& lidar, const std::string& rsu) {
+    std::set<std::string> ids;
+    for (const CalibrationResult& c : results.calibrations)
+      if (c.site == site && c.lidar == lidar) ids.insert(c.rsu);
+    for (const Commissioning& c : results.commissioning)
+      if (c.site == site && c.lidar == lidar) ids.insert(c.rsu);
+    return ids.size() > 1 ? lidar + " (" + rsu + ")" : lidar;
+  };
+
   // The calibration table: what one drive found, and what it is worth on the next one.
   std::ostringstream calibration_md;
   if (!results.calibrations.empty()) {
     std::ostringstream csv;
-    csv << "site,lidar,injected_dx_m,injected_dy_m,injected_dyaw_deg,injected_clock_ms,dx_m,dy_m,dyaw_deg,clock_ms,sd_dx_m,sd_dy_m,sd_dyaw_deg,"
+    csv << "site,lidar,rsu,injected_dx_m,injected_dy_m,injected_dyaw_deg,injected_clock_ms,dx_m,dy_m,dyaw_deg,clock_ms,sd_dx_m,sd_dy_m,sd_dyaw_deg,"
            "sd_clock_ms,observable,clock_observable,next_as_surveyed_m,next_calibrated_m,next_perfect_m\n";
     calibration_md << "| site | roadside LiDAR | injected (dx, dy, dyaw, clock) | found (± sd) | next drive, registry as surveyed | "
                       "calibrated | perfect RSU | calibrated / perfect |\n|---|---|---|---|---|---|---|---|\n";
@@ -246,11 +257,11 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
                       f.dy, f.sd_dy, f.dyaw * deg, f.sd_dyaw * deg);
       else
         std::snprintf(found, sizeof found, "not determined (%s)", f.note.c_str());
-      calibration_md << "| " << cr.site << " | " << cr.lidar << " | " << injected << " | " << found << " | " << fmt("%.2f cm", 100 * as_surveyed)
+      calibration_md << "| " << cr.site << " | " << withRsu(cr.site, cr.lidar, cr.rsu) << " | " << injected << " | " << found << " | " << fmt("%.2f cm", 100 * as_surveyed)
                      << " | " << (std::isnan(calibrated) ? std::string("-") : fmt("%.2f cm", 100 * calibrated)) << " | "
                      << fmt("%.2f cm", 100 * perfect) << " | " << (std::isnan(calibrated) ? std::string("-") : fmt("%.2fx", calibrated / perfect))
                      << " |\n";
-      csv << cr.site << "," << cr.lidar << "," << cr.dx << "," << cr.dy << "," << cr.dyaw * deg << "," << cr.clock_offset * 1e3 << "," << f.dx << ","
+      csv << cr.site << "," << cr.lidar << "," << cr.rsu << "," << cr.dx << "," << cr.dy << "," << cr.dyaw * deg << "," << cr.clock_offset * 1e3 << "," << f.dx << ","
           << f.dy << "," << f.dyaw * deg << "," << f.clock_offset * 1e3 << "," << f.sd_dx << "," << f.sd_dy << "," << f.sd_dyaw * deg << ","
           << f.sd_clock_offset * 1e3 << "," << (f.observable ? 1 : 0) << "," << (f.clock_observable ? 1 : 0) << "," << as_surveyed << "," << calibrated << "," << perfect << "\n";
     }
@@ -288,7 +299,9 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
           std::sort(real.begin(), real.end());
           p95 = real[static_cast<std::size_t>(0.95 * static_cast<double>(real.size() - 1))];
         }
-        sources_md << " " << (n == 0 ? std::string("-") : fmt("%.1f", 100 * mr) + fmt(" / %.1f cm", 100 * mi)) << " |";
+        // A bin with frames but no fix on one side says so ("-") rather than "nan".
+        const auto cm = [&](double v) { return std::isnan(v) ? std::string("-") : fmt("%.1f", 100 * v); };
+        sources_md << " " << (n == 0 ? std::string("-") : cm(mr) + " / " + cm(mi) + " cm") << " |";
         csv << key << "," << (b < kBins ? b * kBin : 0.0) << "," << (b < kBins ? (b + 1) * kBin : 1e3) << "," << n << "," << real.size() << ","
             << ideal.size() << "," << mr << "," << mi << "," << p95 << "\n";
       }
@@ -310,9 +323,12 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
       std::snprintf(drawn, sizeof drawn, "%.3f m, %.3f m, %.3f deg, %.2f ms", cr.dx, cr.dy, cr.dyaw * deg, cr.clock_offset * 1e3);
       const std::string clock =
           f.clock_observable ? fmt("%.2f", f.calibration.clock_offset * 1e3) + fmt(" ± %.2f ms", f.sd[3] * 1e3) : std::string("clock held at 0");
-      std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %s%s", f.calibration.dx, f.sd[0], f.calibration.dy, f.sd[1],
-                    f.calibration.dyaw * deg, f.sd[2] * deg, clock.c_str(), f.determined ? "" : (" (not used: " + f.note + ")").c_str());
-      sources_md << "| " << cr.site << " | " << cr.lidar << " | " << drawn << " | " << found << " | " << f.inliers << " / " << f.outliers << " | "
+      if (f.sd[0] < 0.0)  // nothing estimated (too few fixes)
+        std::snprintf(found, sizeof found, "none (%s)", f.note.c_str());
+      else
+        std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %s%s", f.calibration.dx, f.sd[0], f.calibration.dy, f.sd[1],
+                      f.calibration.dyaw * deg, f.sd[2] * deg, clock.c_str(), f.determined ? "" : (" (not used: " + f.note + ")").c_str());
+      sources_md << "| " << cr.site << " | " << withRsu(cr.site, cr.lidar, cr.rsu) << " | " << drawn << " | " << found << " | " << f.inliers << " / " << f.outliers << " | "
                  << fmt("%.1f cm", 100 * f.residual_sd) << " |\n";
     }
   }
@@ -602,6 +618,11 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         "variance of the fixes' error on the site's first drive, a calibration pass).\n\n"
      << "## Table I: error within coverage\n\n"
      << table1.str() << "\n";
+  if (!results.notes.empty()) {
+    md << "Notes:\n\n";
+    for (const std::string& note : results.notes) md << "- " << note << "\n";
+    md << "\n";
+  }
   if (!smoother_md.str().empty())
     md << "## The smoother against the filter\n\nThe same replays smoothed by the Ceres smoother (`coloc smooth`: every measurement for "
           "every pose, each source's noise measured on the drive); plain means of all samples, within and outside the LiDAR's coverage.\n\n"

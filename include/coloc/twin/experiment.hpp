@@ -41,12 +41,14 @@ struct ExperimentRun {
 /// drive's replays (variants kNextMiscalibrated, kNextCalibrated, kNextPerfect) show what it is worth.
 struct CalibrationResult {
   std::string site, lidar;
+  std::string rsu;  ///< the site's RSU id (a site may have several RSUs of a model)
   double dx = 0.0, dy = 0.0, dyaw = 0.0, clock_offset = 0.0;  ///< injected: m, m, rad, s
   smoother::RsuCalibration found;
 };
 /// An RSU commissioned against the reference vehicle on its site's noise calibration drive.
 struct Commissioning {
   std::string site, lidar;
+  std::string rsu;  ///< the site's RSU id
   double dx = 0.0, dy = 0.0, dyaw = 0.0, clock_offset = 0.0;  ///< drawn: m, m, rad, s
   rsu_client::CommissioningResult found;
 };
@@ -76,7 +78,8 @@ struct ExperimentResults {
   std::vector<SiteInfo> sites;
   std::vector<ExperimentRun> runs;
   ExperimentTiming timing;
-  /// "SITE LIDAR" -> the fixes' variance estimated on the site's noise calibration drive, m^2.
+  /// "SITE LIDAR" ("SITE LIDAR (RSU)" where a site has several RSUs) -> the fixes' variance estimated
+  /// on the site's noise calibration drive, m^2.
   std::map<std::string, double> estimated_variance;
   /// Per site: the odometry's variance of speed ((m/s)^2) and yaw rate ((rad/s)^2) on that drive.
   std::map<std::string, Eigen::Vector2d> estimated_twist_variance;
@@ -91,6 +94,8 @@ struct ExperimentResults {
   /// The same on each site's noise calibration drive, with the ideal twin's fix beside each.
   std::map<std::string, std::vector<RsuFrameRecord>> ideal_comparison;
   std::string work_dir;  ///< the recordings
+  /// What the run could not do as asked and did instead (an RSU too rarely in reach to measure, ...).
+  std::vector<std::string> notes;
 };
 
 struct ExperimentProgress {
