@@ -127,6 +127,9 @@ AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen:
       nearest = i;
     }
   const Eigen::Vector2d a = fit.corners[nearest];
+  // Seen: each of its edges carries a few points (one or two can be a face's noise or a rounded end).
+  constexpr int kCornerSupport = 3;
+  const bool corner_seen = support[nearest] >= kCornerSupport && support[(nearest + 3) % 4] >= kCornerSupport;
   // The rectangle's sides at `a` run along its two axes. Each is oriented into the rectangle; a side of
   // no extent (all points on one face) is oriented away from the LiDAR, behind the face it sees.
   const Eigen::Vector2d e1(std::cos(fit.angle), std::sin(fit.angle)), e2(-std::sin(fit.angle), std::cos(fit.angle));
@@ -143,6 +146,15 @@ AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen:
   const Eigen::Vector2d along = u_is_length ? u : v, across = u_is_length ? v : u;
   AlignedBox box;
   box.alignment_point = a;
+  box.corner_seen = corner_seen;
+  if (!corner_seen) {
+    int face = 0;
+    for (int e = 1; e < 4; ++e)
+      if (support[e] > support[face]) face = e;
+    const Eigen::Vector2d side = fit.corners[(face + 1) % 4] - fit.corners[face];
+    const double expected = std::abs(side.normalized().dot(heading)) >= std::sqrt(0.5) ? length : width;
+    box.face_shortfall = std::max(0.0, expected - side.norm());
+  }
   box.center = a + 0.5 * length * along + 0.5 * width * across;
   const Eigen::Vector2d forward = along.dot(heading) >= 0.0 ? along : -along;
   box.yaw = std::atan2(forward.y(), forward.x());

@@ -86,6 +86,7 @@ const char* toString(Refusal r) {
     case Refusal::kOccluded: return "vehicle partly hidden by another object";
     case Refusal::kNotAtPosition: return "fitted vehicle away from the CAM position";
     case Refusal::kInconsistent: return "disagrees with the vehicle's track";
+    case Refusal::kCornerNotSeen: return "one face seen, no corner to place the vehicle on";
   }
   return "?";
 }
@@ -276,6 +277,9 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // 6. The lowest part of the body, the L-shape fit, the plain centre or the true-size box.
   if (!c.attribute) box = fitBody(vehicle_points, foreground, c, lidar, length, width, heading_prior, xy, &fit);
   if (xy.size() < 3) return finish(Refusal::kNoVehicle);
+  out.corner_seen = box.corner_seen;
+  out.face_shortfall = box.face_shortfall;
+  if (c.attribute && c.align_true_size && box.face_shortfall > c.max_face_shortfall) return finish(Refusal::kCornerNotSeen);
   const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
   if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);
   out.found = true;

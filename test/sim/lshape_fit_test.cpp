@@ -113,6 +113,46 @@ TEST(AlignmentPoint, TrueSizeBoxOnTheNearestCornerBeatsThePlainBoxCentre) {
   EXPECT_LT(aligned, 0.05);
 }
 
+// Points on one face of the box only (the front, seen head-on from the origin), over `visible` of its
+// width from its middle outwards on both sides, 2 cm apart, with 1 cm noise.
+std::vector<Eigen::Vector2d> frontFace(const Eigen::Vector2d& c, double yaw, double visible, std::mt19937& rng) {
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Eigen::Vector2d f(std::cos(yaw), std::sin(yaw)), l(-std::sin(yaw), std::cos(yaw));
+  const Eigen::Vector2d middle = c + 0.5 * kLength * f;
+  std::vector<Eigen::Vector2d> points;
+  for (double s = -0.5 * visible; s <= 0.5 * visible + 1e-9; s += 0.02) points.push_back(middle + s * l + Eigen::Vector2d(noise(rng), noise(rng)));
+  return points;
+}
+
+TEST(AlignmentPoint, ACornerSeenHasNoShortfallAndAWholeFaceAlmostNone) {
+  std::mt19937 rng(8);
+  const Eigen::Vector2d truth(30.0, 1.0);
+  const double yaw = M_PI;  // driving towards the LiDAR: the front faces it
+  const auto l_points = visibleL(truth, yaw + 0.4, 0.6, rng);
+  const AlignedBox l_box = alignTrueSizeBox(fitLShape(l_points), l_points, Eigen::Vector2d::Zero(), kLength, kWidth, yaw + 0.4);
+  EXPECT_TRUE(l_box.corner_seen);
+  EXPECT_EQ(l_box.face_shortfall, 0.0);
+  const auto whole = frontFace(truth, yaw, kWidth, rng);
+  const AlignedBox whole_box = alignTrueSizeBox(fitLShape(whole), whole, Eigen::Vector2d::Zero(), kLength, kWidth, yaw);
+  EXPECT_FALSE(whole_box.corner_seen);
+  EXPECT_LT(whole_box.face_shortfall, 0.05);
+  EXPECT_LT((whole_box.center - truth).norm(), 0.05) << "a face seen whole ends at true corners";
+}
+
+TEST(AlignmentPoint, APartOfOneFaceFallsShortByWhatIsNotSeenAndItsBoxIsOffByAboutHalfOfThat) {
+  std::mt19937 rng(9);
+  const Eigen::Vector2d truth(30.0, 1.0);
+  const double yaw = M_PI;
+  for (const double visible : {0.6, 1.0, 1.4}) {
+    const auto points = frontFace(truth, yaw, visible, rng);
+    const AlignedBox box = alignTrueSizeBox(fitLShape(points), points, Eigen::Vector2d::Zero(), kLength, kWidth, yaw);
+    EXPECT_FALSE(box.corner_seen);
+    EXPECT_NEAR(box.face_shortfall, kWidth - visible, 0.05) << visible << " m of the front seen";
+    // The box rests on the seen part's end, a guess: across the road it is off by half what is missing.
+    EXPECT_NEAR((box.center - truth).norm(), 0.5 * (kWidth - visible), 0.05) << visible << " m of the front seen";
+  }
+}
+
 TEST(LShapeFit, TooFewPointsIsAnError) {
   EXPECT_THROW(fitLShape({Eigen::Vector2d(1, 1)}), Error);
 }

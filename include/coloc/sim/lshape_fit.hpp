@@ -37,6 +37,11 @@ struct AlignedBox {
   Eigen::Vector2d center;           ///< centre of the true-size box
   double yaw;                       ///< heading of its length axis, resolved with the prior
   Eigen::Vector2d alignment_point;  ///< the fitted corner closest to the LiDAR
+  bool corner_seen = true;          ///< both edges at the alignment point carry points
+  /// Without a seen corner: how much shorter the one face seen is than the vehicle's side it belongs to
+  /// (length or width, by the heading prior), m. A face seen whole ends at the vehicle's corners and the
+  /// box still rests on a true one; a partial face's end is anywhere along the body.
+  double face_shortfall = 0.0;
 };
 
 /// Places a box of `length` x `width` on the alignment point and extends it along the rectangle's edges

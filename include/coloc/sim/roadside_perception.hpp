@@ -36,6 +36,11 @@ struct RoadsidePerceptionConfig {
   /// Points of other objects that hide part of the vehicle's expected footprint from the LiDAR (nearer
   /// to it, within the footprint's bearing) make the view partial: refused from this many.
   int occlusion_points = 5;
+  /// The true-size box rests on the fitted corner nearest the LiDAR. With one face of the vehicle seen
+  /// and no corner, that face's end is a corner only if the face is seen whole; one shorter than its side
+  /// of the vehicle by more than this (head-on from afar, a high mount's few beams on the chassis) puts
+  /// the box on a guess up to half the vehicle off: refused (with `attribute` and `align_true_size`).
+  double max_face_shortfall = 0.3;  ///< m
   LShapeConfig lshape;
 };
 
@@ -54,9 +59,10 @@ enum class Refusal {
   kOccluded,       ///< another object between the LiDAR and the vehicle
   kNotAtPosition,  ///< the fitted vehicle is farther from the CAM's position than attribution_radius
   kInconsistent,   ///< disagrees with the vehicle's track (FixConsistency), or has none to agree with
+  kCornerNotSeen,  ///< one face seen: no corner to rest the vehicle's box on
 };
 const char* toString(Refusal r);
-inline constexpr int kRefusalCount = 7;
+inline constexpr int kRefusalCount = 8;
 
 struct VehicleDetection {
   bool found = false;
@@ -65,6 +71,8 @@ struct VehicleDetection {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< vehicle centre, map frame
   double yaw = 0.0;                ///< map frame
   Eigen::Vector2d alignment_point = Eigen::Vector2d::Zero();
+  bool corner_seen = true;         ///< AlignedBox::corner_seen of the fit
+  double face_shortfall = 0.0;     ///< AlignedBox::face_shortfall of the fit, m
   std::size_t foreground_points = 0, fit_points = 0;
   double processing_ms = 0.0;      ///< measured, the whole pipeline
 };
