@@ -1,6 +1,7 @@
 // `coloc simulate SCENARIO --out DIR`: drives the digital twin and records what the vehicle would have
 // recorded, as a rosbag2 log that `coloc fuse` replays and ROS 2 plays (see twin_recording.hpp).
 #include <cstdio>
+#include <filesystem>
 
 #include "coloc/sim/scene.hpp"
 #include "commands.hpp"
@@ -48,8 +49,12 @@ void addSimulateCommand(CLI::App& app) {
                 s.rays / std::max(s.ray_casting_seconds, 1e-9) * 1e-6);
     std::printf("  time: survey map %.1f s, ray casting %.1f s, roadside perception %.2f s, the rest %.1f s\n", s.map_seconds,
                 s.ray_casting_seconds, s.perception_seconds, s.wall_seconds - s.map_seconds - s.ray_casting_seconds - s.perception_seconds);
-    std::printf("  wrote %s/{log/, map/, fuse.yaml, rsu_fixes.csv, rsu_frames.csv, rsu_fix_error.svg, rsu_perception.csv, rsu_perception.svg}\n",
-                out_dir.c_str());
+    // What is there to see: the plots exist only when an RSU sent something to plot.
+    std::string wrote;
+    for (const char* name : {"log/", "map/", "fuse.yaml", "rsu.yaml", "rsu_fixes.csv", "rsu_frames.csv", "rsu_fix_error.svg", "rsu_perception.csv",
+                             "rsu_perception.svg"})
+      if (std::filesystem::exists(out_dir + "/" + name)) wrote += (wrote.empty() ? "" : ", ") + std::string(name);
+    std::printf("  wrote %s/{%s}\n", out_dir.c_str(), wrote.c_str());
   });
 }
 

@@ -377,6 +377,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   };
   for (const std::string& site : config.sites) {
     scenarios.push_back(siteScenario(site, config));
+    if (scenarios.back().rsus.empty())
+      throw Error(site + ": the site has no RSU (rsus:), and the experiment compares NDT alone with NDT + an RSU's fixes "
+                  "(coloc simulate and coloc fuse drive and replay a site without one)");
     results.sites.push_back(siteInfo(scenarios.back()));
   }
   std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU id -> variance

@@ -161,6 +161,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         const ExperimentRun* fused = find(results.runs, site.name, t, lidar, 0, 0, "");
         if (!ndt || !fused) continue;
         const ErrorInCoverage a = errorInCoverage(*ndt, range, bin), b = errorInCoverage(*fused, range, bin);
+        if (a.samples == 0) continue;  // the drive never within this LiDAR's coverage of any RSU
         ndt_p.push_back(a.paper), fused_p.push_back(b.paper), ndt_m.push_back(a.plain), fused_m.push_back(b.plain);
         gain.push_back(improvement(a.paper, b.paper));
         if (const ExperimentRun* ref = find(results.runs, site.name, t, lidar, 0, 0, reference))
@@ -169,6 +170,11 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
           const ErrorInCoverage e = errorInCoverage(*sm, range, bin);
           smooth_p.push_back(e.paper), smooth_m.push_back(e.plain);
         }
+      }
+      if (ndt_p.empty()) {
+        table1 << "| " << site.name << " | " << lidar << " | " << fmt("%.0f m", range) << " | never in coverage | - | - | - | - | - | - | - | - |\n";
+        table1_csv << site.name << "," << lidar << "," << range << ",0,,,,,,,,,,,,,,,\n";
+        continue;
       }
       const Spread np = spread(ndt_p), fp = spread(fused_p), nm = spread(ndt_m), fm = spread(fused_m), g = spread(gain), rp = spread(ref_p),
                    sp = spread(smooth_p), sm = spread(smooth_m);
