@@ -45,7 +45,7 @@ ndt::PointCloud toPointCloud(const io::PointCloud2& m) {
   const io::PointField* fy = field(m, {"y"});
   const io::PointField* fz = field(m, {"z"});
   if (!fx || !fy || !fz) throw Error("PointCloud2: no x, y and z fields");
-  const io::PointField* ft = field(m, {"time", "t", "time_stamp", "timestamp"});
+  const io::PointField* ft = field(m, {"time", "t", "time_stamp", "timestamp", "offset_time"});
   for (const io::PointField* f : {fx, fy, fz, ft}) {
     if (!f) continue;
     const std::size_t size = sizeOf(f->datatype);
@@ -60,8 +60,9 @@ ndt::PointCloud toPointCloud(const io::PointCloud2& m) {
     throw Error("PointCloud2: data is shorter than height x row_step, or point_step is inconsistent");
   ndt::PointCloud cloud;
   cloud.points.reserve(count);
-  // Drivers give per-point time as seconds (float) relative to the sweep, nanoseconds (uint32, Ouster)
-  // or absolute seconds (float64): all become seconds relative to the first point.
+  // Drivers give per-point time as seconds (float) relative to the sweep, nanoseconds (uint32: Ouster's
+  // t, Livox's offset_time), absolute seconds (float64: Hesai, RoboSense) or absolute nanoseconds in a
+  // float64 (Livox's timestamp): all become seconds relative to the first point.
   std::vector<double> times;
   if (ft) times.reserve(count);
   const auto isFloat = [](const io::PointField* f) { return !f || f->datatype == io::PointField::kFloat32; };
@@ -93,9 +94,18 @@ ndt::PointCloud toPointCloud(const io::PointCloud2& m) {
       }
   }
   if (ft && !times.empty()) {
-    double first = times.front();
-    for (double t : times) first = std::min(first, t);
-    const double scale = ft->datatype == io::PointField::kUint32 ? 1e-9 : 1.0;
+    double first = times.front(), last = times.front();
+    for (double t : times) first = std::min(first, t), last = std::max(last, t);
+    // Integers count nanoseconds. A float's unit shows in the span: a sweep lasts a fraction of a
+    // second, so a span of more than a second is of nanoseconds (or microseconds), never seconds.
+    const double span = last - first;
+    double scale = 1.0;
+    if (ft->datatype != io::PointField::kFloat32 && ft->datatype != io::PointField::kFloat64) scale = 1e-9;
+    else if (!std::isfinite(span)) throw Error("PointCloud2: field " + ft->name + " holds a time that is not a finite number");
+    else if (span > 1.0) scale = span * 1e-6 <= 1.0 ? 1e-6 : 1e-9;
+    if (span * scale > 1.0)
+      throw Error("PointCloud2: field " + ft->name + " spans " + std::to_string(span) +
+                  " units, more than a second of one sweep in seconds, microseconds or nanoseconds");
     cloud.times.reserve(times.size());
     for (double t : times) cloud.times.push_back(static_cast<float>((t - first) * scale));
   }

@@ -79,6 +79,41 @@ TEST(MessageInputs, PointCloud2GivesItsFinitePointsWithTimesFromTheFirstWhatever
   }
 }
 
+// The time field rewritten: point i at `origin + 0.01 i` seconds, counted in `unit`s.
+io::PointCloud2 timedIn(std::uint8_t time_type, double origin, double unit, const std::string& name = "time") {
+  io::PointCloud2 m = cloud({io::PointField::kFloat32, time_type, 24, 0}, std::vector<Eigen::Vector3d>(6, Eigen::Vector3d(1, 2, 3)));
+  m.fields.back().name = name;
+  for (std::uint32_t i = 0; i < 6; ++i) putAs(m.data, i * m.point_step + 12, time_type, (origin + 0.01 * i) / unit);
+  return m;
+}
+
+TEST(MessageInputs, PointCloud2TimesInNanosecondsOrMicrosecondsAreToldFromTheirSpanAndBecomeSeconds) {
+  struct Case {
+    const char* what;
+    std::uint8_t type;
+    double origin, unit;
+    const char* name;
+  };
+  for (const Case& k : {Case{"absolute seconds, float64 (Hesai, RoboSense)", io::PointField::kFloat64, 1.7e9, 1.0, "timestamp"},
+                        Case{"absolute nanoseconds, float64 (Livox)", io::PointField::kFloat64, 1.7e9, 1e-9, "timestamp"},
+                        Case{"microseconds from the sweep's start, float32", io::PointField::kFloat32, 0.0, 1e-6, "time"},
+                        Case{"nanoseconds from the sweep's start, uint32 (Livox)", io::PointField::kUint32, 0.0, 1e-9, "offset_time"}}) {
+    const ndt::PointCloud c = toPointCloud(timedIn(k.type, k.origin, k.unit, k.name));
+    ASSERT_EQ(c.times.size(), 6u) << k.what;
+    for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(c.times[i], 0.01 * static_cast<double>(i), 1e-6) << k.what << ", point " << i;
+  }
+}
+
+TEST(MessageInputs, PointCloud2TimesSpanningMoreThanASweepInAnyUnitAreRefusedNamingTheField) {
+  // 0.01 s apart in units of 1e-12 s: 5e10 units, more than a second even as nanoseconds.
+  try {
+    toPointCloud(timedIn(io::PointField::kFloat64, 0.0, 1e-12));
+    FAIL() << "a cloud whose times span 50 s was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("field time spans"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MessageInputs, PointCloud2WithoutATimeFieldGivesPointsWithoutTimes) {
   io::PointCloud2 m = cloud({io::PointField::kFloat32, io::PointField::kFloat32, 16, 0}, std::vector<Eigen::Vector3d>(6, Eigen::Vector3d(1, 2, 3)));
   m.fields.pop_back();
