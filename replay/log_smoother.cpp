@@ -110,8 +110,28 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   options.replay.keep_filter_inputs = true;
   SmoothResult result;
   result.filter = replayLog(log_path, options.replay);
-  const ReplayResult& f = result.filter;
-  if (f.fused_states.size() < 2) throw Error(log_path + ": the filter gave fewer than two estimates: nothing to smooth");
+  if (result.filter.fused_states.size() < 2) throw Error(log_path + ": the filter gave fewer than two estimates: nothing to smooth");
+  std::optional<rsu_client::RsuRegistry> registry = options.replay.registry;
+  if (!registry && !options.replay.config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(options.replay.config.rsu.registry);
+  if (registry) result.registry = *registry;
+  std::set<std::string> fix_sources;
+  if (registry)
+    for (const rsu_client::RsuInfo& rsu : registry->rsus()) fix_sources.insert(rsu_client::fixTopic(rsu.id));
+  for (const auto& [topic, input] : options.replay.config.inputs)
+    if (input.role == pipeline::InputRole::kRsuFix) fix_sources.insert(topic);
+  // Calibrating an RSU, its fixes must not have steered the anchor: NDT starts from the filter's
+  // prediction, and a filter that followed a miscalibrated RSU drags NDT with it (on site B's open
+  // stretch 0.56 m on average, and the RSU then came out 0.39 m off). The anchor (guesses, NDT's poses,
+  // twists) comes from a replay without the fixes; the fixes themselves from the replay with them.
+  std::optional<ReplayResult> anchor;
+  if (options.calibrate_rsus && options.window <= 0.0) {
+    ReplayOptions without = options.replay;
+    without.progress = nullptr;
+    for (const std::string& topic : fix_sources) without.config.inputs[topic].role = pipeline::InputRole::kIgnore;
+    anchor = replayLog(log_path, without);
+    if (anchor->fused_states.size() < 2) throw Error(log_path + ": the filter without the fixes gave fewer than two estimates: nothing to calibrate against");
+  }
+  const ReplayResult& f = anchor ? *anchor : result.filter;
   const auto start = std::chrono::steady_clock::now();
   if (options.window > 0.0) {
     smoothFixedLag(options, result);
@@ -127,18 +147,13 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   if (options.replay.config.pipeline.initial_pose && !f.fused_state_covariances.empty())
     s.addPrior(f.fused_states.front().first, f.fused_states.front().second, f.fused_state_covariances.front());
   for (const auto& [source, pose] : f.filter_poses) s.addPose(source, pose);
+  if (anchor)
+    for (const auto& [source, pose] : result.filter.filter_poses)
+      if (fix_sources.count(source)) s.addPose(source, pose);
   // With the odometry's calibration estimated, the twists as the log has them: the filter's were
   // scaled by what NDT had taught so far, a scale that changes along the drive.
   for (const auto& [source, twist] : options.smoother.calibrate_odometry ? f.received_twists : f.filter_twists) s.addTwist(source, twist);
-  std::optional<rsu_client::RsuRegistry> registry = options.replay.registry;
-  if (!registry && !options.replay.config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(options.replay.config.rsu.registry);
-  if (registry) result.registry = *registry;
   // Every pose source but the RSUs' fixes is map matching of some kind, whose error is a slow bias.
-  std::set<std::string> fix_sources;
-  if (registry)
-    for (const rsu_client::RsuInfo& rsu : registry->rsus()) fix_sources.insert(rsu_client::fixTopic(rsu.id));
-  for (const auto& [topic, input] : options.replay.config.inputs)
-    if (input.role == pipeline::InputRole::kRsuFix) fix_sources.insert(topic);
   for (const auto& [source, pose] : f.filter_poses)
     if (!fix_sources.count(source)) s.setPoseBias(source);
   if (options.calibrate_rsus) {
