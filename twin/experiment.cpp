@@ -125,11 +125,11 @@ struct Job {
   std::string log, map;
   std::shared_ptr<replay::ReplayCache> cache;  ///< shared by the drive's replays
   pipeline::Config config;
-  std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSU, its fixes through the registry's checks
+  std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSUs, their fixes through the registry's checks
   std::vector<std::string> fix_topics;  ///< the fused RSUs' topics (every RSU of the LiDAR model), none for NDT only
   std::vector<Eigen::Vector2d> rsu_positions;
   bool smooth = false;     ///< also smooth the log: `smoothed`
-  bool calibrate = false;  ///< smooth with the RSU's calibration: `calibrated`
+  bool calibrate = false;  ///< smooth with the RSUs' calibrations: `calibrations`, `calibrated`
   std::optional<ExperimentRun> smoothed;
   std::map<std::string, smoother::RsuCalibration> calibrations;  ///< per RSU id, with `calibrate`
   std::optional<rsu_client::RsuRegistry> calibrated;  ///< the registry with the calibrations found
