@@ -108,6 +108,10 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   if (options.window > 0.0 && !(std::isfinite(options.window_step) && options.window_step > 0.0))
     throw Error("smooth: the window step must be a finite number of seconds > 0");
   options.replay.keep_filter_inputs = true;
+  // Calibrating, the log is replayed twice (below): each replay is half of the progress.
+  const bool two_replays = options.calibrate_rsus && options.window <= 0.0;
+  const std::function<void(double)> progress = options.replay.progress;
+  if (two_replays && progress) options.replay.progress = [&](double f) { progress(0.5 * f); };
   SmoothResult result;
   result.filter = replayLog(log_path, options.replay);
   if (result.filter.fused_states.size() < 2) throw Error(log_path + ": the filter gave fewer than two estimates: nothing to smooth");
@@ -124,9 +128,9 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
   // stretch 0.56 m on average, and the RSU then came out 0.39 m off). The anchor (guesses, NDT's poses,
   // twists) comes from a replay without the fixes; the fixes themselves from the replay with them.
   std::optional<ReplayResult> anchor;
-  if (options.calibrate_rsus && options.window <= 0.0) {
+  if (two_replays) {
     ReplayOptions without = options.replay;
-    without.progress = nullptr;
+    if (progress) without.progress = [&](double f) { progress(0.5 + 0.5 * f); };
     for (const std::string& topic : fix_sources) without.config.inputs[topic].role = pipeline::InputRole::kIgnore;
     anchor = replayLog(log_path, without);
     if (anchor->fused_states.size() < 2) throw Error(log_path + ": the filter without the fixes gave fewer than two estimates: nothing to calibrate against");
