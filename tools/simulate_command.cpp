@@ -49,6 +49,10 @@ void addSimulateCommand(CLI::App& app) {
                 s.rays / std::max(s.ray_casting_seconds, 1e-9) * 1e-6);
     std::printf("  time: survey map %.1f s, ray casting %.1f s, roadside perception %.2f s, the rest %.1f s\n", s.map_seconds,
                 s.ray_casting_seconds, s.perception_seconds, s.wall_seconds - s.map_seconds - s.ray_casting_seconds - s.perception_seconds);
+    // A scenario's RSU the route never brings within coverage is most likely a mistake in the scenario.
+    for (const sim::ScenarioRsu& r : scenario.rsus)
+      if (s.rsu_frames.count(r.id) == 0)
+        std::printf("  note: %s (%s) never had the vehicle within its coverage: no frame, no fix\n", r.id.c_str(), r.lidar_model.c_str());
     // What is there to see: the plots exist only when an RSU sent something to plot.
     std::string wrote;
     for (const char* name : {"log/", "map/", "fuse.yaml", "rsu.yaml", "rsu_fixes.csv", "rsu_frames.csv", "rsu_fix_error.svg", "rsu_perception.csv",
