@@ -259,6 +259,19 @@ TEST(McapRecovery, AChannelOnAnUndefinedSchemaEndsTheReadingWhereTheCountingScan
   EXPECT_NE(recovered[0].reason.find("refers to schema 44"), std::string::npos) << recovered[0].reason;
 }
 
+TEST(McapRecovery, TheFuzzersFindingsReadExactlyAsManyMessagesAsTheirOpeningCountedKeptOrNot) {
+  for (const char* name : {"mcap_cut_attachment_read_only_when_kept.mcap", "mcap_cut_channel_registered_before_its_refusal.mcap"})
+    for (const bool keep : {false, true}) {
+      BagReader reader = BagReader::open(std::string(COLOC_SOURCE_DIR "/test/support/fuzz_findings/") + name, BagReadOptions{true});
+      reader.keepAttachments(keep);
+      std::uint64_t read = 0;
+      BagMessage m;
+      while (reader.next(m)) ++read;
+      EXPECT_EQ(read, reader.messageCount()) << name << ", attachments kept: " << keep;
+      EXPECT_EQ(reader.recovered().size(), 1u) << name;
+    }
+}
+
 TEST(McapRecovery, AFileCutInsideItsHeaderHasNothingToRecoverAndIsRefused) {
   ScratchDir dir;
   const std::vector<std::uint8_t> full = readBytes(nav2Bag());
