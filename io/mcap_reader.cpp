@@ -366,7 +366,6 @@ void McapReader::rewind() {
 
 bool McapReader::next(BagMessage& message) {
   if (!cut_) return nextRecord(message);
-  if (done_ && chunk_position_ >= chunk_.size()) return false;
   try {
     if (nextRecord(message)) return true;
     if (recovery_->reason.empty()) {

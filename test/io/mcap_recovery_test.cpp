@@ -37,6 +37,14 @@ std::vector<TopRecord> topRecords(const std::vector<std::uint8_t>& file) {
   return records;
 }
 
+/// The Chunk records among them.
+std::vector<TopRecord> chunkRecords(const std::vector<std::uint8_t>& file) {
+  std::vector<TopRecord> chunks;
+  for (const TopRecord& r : topRecords(file))
+    if (r.opcode == 0x06) chunks.push_back(r);
+  return chunks;
+}
+
 std::vector<BagMessage> readRecovering(const std::string& path, std::vector<RecoveredFile>* recovered = nullptr,
                                        std::uint64_t* counted = nullptr) {
   BagReader reader = BagReader::open(path, BagReadOptions{true});
@@ -79,9 +87,7 @@ TEST(McapRecovery, ACutFileGivesExactlyTheMessagesOfTheChunksThatEndBeforeTheCut
   const std::string whole = oneMessagePerChunk(dir, 40);
   const std::vector<BagMessage> expected = readAllMessages(whole);
   const std::vector<std::uint8_t> full = readBytes(whole);
-  std::vector<TopRecord> chunks;
-  for (const TopRecord& r : topRecords(full))
-    if (r.opcode == 0x06) chunks.push_back(r);
+  const std::vector<TopRecord> chunks = chunkRecords(full);
   ASSERT_EQ(chunks.size(), expected.size());  // the layout the expectation rests on
   // Cuts at a chunk's first byte, inside its prefix, inside its content, one byte short of its end.
   for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{17}, chunks.size() - 1}) {
@@ -170,9 +176,7 @@ TEST(McapRecovery, ZerosAfterTheCutAsAPowerCutLeavesThemEndReadingAtTheFirstOfTh
   const std::string whole = oneMessagePerChunk(dir, 20);
   const std::vector<BagMessage> expected = readAllMessages(whole);
   std::vector<std::uint8_t> bytes = readBytes(whole);
-  std::vector<TopRecord> chunks;
-  for (const TopRecord& r : topRecords(bytes))
-    if (r.opcode == 0x06) chunks.push_back(r);
+  const std::vector<TopRecord> chunks = chunkRecords(bytes);
   ASSERT_EQ(chunks.size(), expected.size());
   // The file's blocks were allocated, their data never written: zeros from chunk 12 on.
   bytes.resize(chunks[12].offset);
@@ -290,9 +294,7 @@ TEST(McapRecovery, AnUnclosedSplitRecordingReadsItsWholeFilesAndTheLastUpToItsCu
   const std::string whole = oneMessagePerChunk(source, 30);
   const std::vector<BagMessage> expected = readAllMessages(whole);
   const std::vector<std::uint8_t> full = readBytes(whole);
-  std::vector<TopRecord> chunks;
-  for (const TopRecord& r : topRecords(full))
-    if (r.opcode == 0x06) chunks.push_back(r);
+  const std::vector<TopRecord> chunks = chunkRecords(full);
   const std::string bag = dir / "bag";
   std::filesystem::create_directory(bag);
   writeBytes(bag + "/bag_0.mcap", full);
