@@ -298,6 +298,11 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   std::sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
     return a.arrival != b.arrival ? a.arrival < b.arrival : a.order < b.order;
   });
+  if (options.until > 0) {
+    const auto later = std::upper_bound(events.begin(), events.end(), options.until, [](Stamp t, const Event& e) { return t < e.arrival; });
+    result.inputs_after_until = static_cast<std::uint64_t>(events.end() - later);
+    events.erase(later, events.end());
+  }
   drive(events, options, std::move(registry), result);
   if (result.fused.empty())
     throw Error(log_path + ": nothing fused: no input gave the filter a pose it could start from or accept (" +

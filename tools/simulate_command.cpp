@@ -44,11 +44,12 @@ void addSimulateCommand(CLI::App& app) {
     progress.finish();
     std::printf("simulated %s: %.1f s of driving in %.1f s (%.1fx real time)\n", scenario.name.c_str(), s.drive_seconds, s.wall_seconds,
                 s.drive_seconds / s.wall_seconds);
-    std::printf("  %llu roof scans, %llu RSU fixes recorded (%llu lost on the link); %.2f M rays/s of ray casting\n",
-                (unsigned long long)s.scans, (unsigned long long)s.fixes, (unsigned long long)s.fixes_lost,
+    std::printf("  %llu roof scans, %llu RSU fixes recorded (%llu lost on the link); %.1f M rays cast at %.2f M rays/s\n",
+                (unsigned long long)s.scans, (unsigned long long)s.fixes, (unsigned long long)s.fixes_lost, s.rays * 1e-6,
                 s.rays / std::max(s.ray_casting_seconds, 1e-9) * 1e-6);
-    std::printf("  time: survey map %.1f s, ray casting %.1f s, roadside perception %.2f s, the rest %.1f s\n", s.map_seconds,
-                s.ray_casting_seconds, s.perception_seconds, s.wall_seconds - s.map_seconds - s.ray_casting_seconds - s.perception_seconds);
+    std::printf("  time: survey map %.1f s, ray casting %.1f s, LiDAR noise and dropouts %.1f s, roadside perception %.2f s, the rest %.1f s\n",
+                s.map_seconds, s.ray_casting_seconds, s.lidar_seconds, s.perception_seconds,
+                s.wall_seconds - s.map_seconds - s.ray_casting_seconds - s.lidar_seconds - s.perception_seconds);
     // A scenario's RSU the route never brings within coverage is most likely a mistake in the scenario.
     for (const sim::ScenarioRsu& r : scenario.rsus)
       if (s.rsu_frames.count(r.id) == 0)

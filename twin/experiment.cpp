@@ -130,6 +130,7 @@ struct Job {
   std::vector<Eigen::Vector2d> rsu_positions;
   bool smooth = false;     ///< also smooth the log: `smoothed`
   bool calibrate = false;  ///< smooth with the RSUs' calibrations: `calibrations`, `calibrated`
+  Stamp until = 0;         ///< the replay ends here (0: at the log's end): replay::ReplayOptions::until
   std::optional<ExperimentRun> smoothed;
   std::map<std::string, smoother::RsuCalibration> calibrations;  ///< per RSU id, with `calibrate`
   std::optional<rsu_client::RsuRegistry> calibrated;  ///< the registry with the calibrations found
@@ -145,9 +146,11 @@ void writeReplayConfig(const Job& job, const std::string& dir) {
     std::ofstream(dir + "/" + name + "_rsu.yaml") << job.registry->toYaml();
     config.rsu.registry = name + "_rsu.yaml";
   }
+  // Its figures all lie within coverage: the experiment ended the replay there (the same figures).
+  const std::string ended = job.until ? "# (the experiment ended it at stamp " + formatSeconds(job.until) + ", past the RSUs' coverage)\n" : std::string();
   std::ofstream(dir + "/" + name + ".yaml") << pipeline::configYaml(
       config, "# " + job.run.label() + ", as the experiment replayed it:\n# coloc fuse " + job.log + " --map " + job.map + " --config " + dir + "/" +
-                  name + ".yaml\n\n");
+                  name + ".yaml\n" + ended + "\n");
 }
 
 // A run's error along the drive from a replay's ground truth and error samples.
@@ -169,6 +172,32 @@ void fillRun(ExperimentRun& run, const std::vector<io::TrajectoryPoint>& ground_
   }
 }
 
+// Whether every figure the report draws from a run lies within the RSUs' coverage: the network grid
+// (Tables II and III), the calibration study's next drives, and Table I's second covariance unless the
+// sweeps table lists it over all samples too. Such a run need not be replayed past coverage.
+bool reportedWithinCoverageOnly(const ExperimentRun& run, const ExperimentConfig& config) {
+  if (run.lidar.empty()) return false;  // NDT only: Table I's all-samples columns and figures 4 and 5
+  if (run.delay > 0.0 || run.loss > 0.0) return true;
+  if (run.variant == kNextMiscalibrated || run.variant == kNextCalibrated || run.variant == kNextPerfect) return true;
+  return !config.sweeps && run.variant.rfind("covariance ", 0) == 0;
+}
+
+// Where a replay of the drive can end with every figure within coverage as a whole replay has it: a
+// second after the vehicle was last within `range` of an RSU of the site, or after the last fix of the
+// fused RSUs arrived through a link of `delay` (the fix counters count it), whichever is later. The
+// second covers a tick between two ground-truth samples and NDT's answer to the last scan.
+Stamp coverageEnd(const TwinRecordingSummary& drive, const std::vector<Eigen::Vector2d>& rsus, double range, const std::vector<std::string>& fix_topics,
+                  double delay) {
+  Stamp end = 0;
+  for (const auto& [stamp, position] : drive.truth)
+    for (const Eigen::Vector2d& rsu : rsus)
+      if ((position - rsu).norm() <= range) end = std::max(end, stamp);
+  if (drive.log)
+    for (const io::BagMessage& m : drive.log->messages())
+      if (std::find(fix_topics.begin(), fix_topics.end(), m.topic) != fix_topics.end()) end = std::max(end, m.log_time + fromSeconds(delay));
+  return end + kNanosPerSecond;
+}
+
 // Replays one configuration (and smooths it, when asked) and measures its error along the drive.
 void runJob(Job& job) {
   replay::ReplayOptions options;
@@ -176,6 +205,7 @@ void runJob(Job& job) {
   options.registry = job.registry;
   options.map = job.map;
   options.cache = job.cache;
+  options.until = job.until;
   replay::ReplayResult r;
   if (job.smooth || job.calibrate) {
     replay::SmoothOptions so;
@@ -485,6 +515,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     results.timing.ray_casting += summary.ray_casting_seconds;
     results.timing.perception += summary.perception_seconds;
     results.timing.rays += summary.rays;
+    results.timing.reused_sweeps += summary.reused_sweeps;
+    results.timing.lidar += summary.lidar_seconds;
     results.timing.driven_seconds += summary.drive_seconds;
     const double simulated_in = recorded.seconds;
 
@@ -658,6 +690,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
       for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));
     }
+    // Runs whose figures all lie within coverage end there.
+    double widest = 0.0;
+    for (const std::string& lidar : config.lidars)
+      if (const rsu_client::LidarModel* m = rsu_client::findLidarModel(lidar)) widest = std::max(widest, m->range);
+    for (Job& j : jobs)
+      if (reportedWithinCoverageOnly(j.run, config)) j.until = coverageEnd(summary, rsu_positions, widest, j.fix_topics, j.run.delay);
     // Table I's smoother column: the NDT-only replay and each LiDAR's on the ideal network.
     if (drive.variant.empty() && config.smoother)
       for (Job& j : jobs)

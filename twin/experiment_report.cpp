@@ -696,7 +696,9 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   }
   md << "## Run time\n\n"
      << fmt("%.0f s in all", tm.total) << fmt(": survey maps %.1f s, ", tm.survey) << fmt("simulating %.0f s of driving ", tm.driven_seconds) << fmt("%.1f s ", tm.simulation)
-     << fmt("(ray casting %.1f s at ", tm.ray_casting) << fmt("%.1f M rays/s, ", tm.rays / std::max(tm.ray_casting, 1e-9) * 1e-6)
+     << fmt("(ray casting %.1f s: ", tm.ray_casting) << fmt("%.0f M rays at ", tm.rays * 1e-6)
+     << fmt("%.1f M rays/s, ", tm.rays / std::max(tm.ray_casting, 1e-9) * 1e-6) << tm.reused_sweeps
+     << " sweeps and frames reused from an earlier drive of the site; " << fmt("the LiDARs' noise and dropouts %.1f s, ", tm.lidar)
      << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
      << "(" << c.jobs << " side by side).\n\n"
      << "## Files\n\n"

@@ -391,6 +391,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     gt.twist.linear = {truth.speed, 0, 0};
     gt.twist.angular = {0, 0, truth.yaw_rate};
     bag.write("/ground_truth/odom", at(t), io::encodeOdometry(gt));
+    summary.truth.emplace_back(at(t), truth.position);
     if (k % 2 == 0) {  // 50 Hz odometry, logged 2 ms after sensing
       const sim::OdometrySample o = sim::measureOdometry(truth, odometry_noise, rng);
       summary.odometry.emplace_back(o.speed, truth.speed, o.yaw_rate, truth.yaw_rate);
@@ -406,22 +407,30 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     // 10 Hz: a roof sweep, and each RSU's frame; the traffic where it is half-way through them.
     const double capture = t + 0.05;
     const sim::VehicleState seen = drive.at(capture);
-    const auto c0 = Clock::now();
     // The LiDAR as mounted, which its recorded extrinsic (yaw 0) misses by errors.lidar_mount_yaw.
     const sim::SensorTrajectory roof_pose = [&](double dt) {
       return vehiclePose(drive.at(t + dt), scenario.vehicle_lidar_height) * Eigen::AngleAxisd(errors.lidar_mount_yaw, Eigen::Vector3d::UnitZ());
     };
     // The worlds are moved to the capture time only for a sweep cast afresh (placing rebuilds their BVH).
+    bool cast_now = false;
     auto cast = [&] {
+      const auto c0 = Clock::now();
       scene.place(capture, nullptr);
-      return sim::castSweep(roof, scene.caster(), roof_pose);
+      std::vector<sim::RayHit> hits = sim::castSweep(roof, scene.caster(), roof_pose);
+      summary.ray_casting_seconds += since(c0);
+      summary.rays += raysPerSweep(roof);
+      cast_now = true;
+      return hits;
     };
-    if (options.roof_sweeps)
-      sim::sweepPoints(roof, *options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast), rng, sweep);
-    else
-      sim::sweepPoints(roof, cast(), rng, sweep);
-    summary.ray_casting_seconds += since(c0);
-    summary.rays += raysPerSweep(roof);
+    {
+      const std::shared_ptr<const std::vector<sim::RayHit>> hits =
+          options.roof_sweeps ? options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast)
+                              : std::make_shared<const std::vector<sim::RayHit>>(cast());
+      if (!cast_now) ++summary.reused_sweeps;
+      const auto c0 = Clock::now();
+      sim::sweepPoints(roof, *hits, rng, sweep);
+      summary.lidar_seconds += since(c0);
+    }
     bag.writeScan("/points", at(t + 0.1) + 5'000'000, sweep, at(t));  // the sweep ends, the driver publishes
     ++summary.scans;
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
@@ -439,25 +448,33 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       if (distance > r.range) continue;
       const Eigen::Isometry3d pose = Eigen::Translation3d(r.info.position.x(), r.info.position.y(), r.info.height) *
                                      Eigen::AngleAxisd(r.info.yaw, Eigen::Vector3d::UnitZ());
-      const auto c1 = Clock::now();
       if (options.rsu_frames) {
         // Keyed by RSU and sweep; the fingerprint adds where the vehicle is, which the world holds.
         const sim::SensorTrajectory still = [&](double) { return pose; };
         const double ego[3] = {seen.position.x(), seen.position.y(), seen.yaw};
         const std::uint64_t key = (static_cast<std::uint64_t>(&r - rsus.data()) << 32) | summary.scans;
-        const auto hits = options.rsu_frames->get(key, sim::sweepFingerprint(r.lidar, still, ego, 3),
-                                                  [&] {
-                                                    placeVehicle();
-                                                    return sim::castSweep(r.lidar, with_vehicle.caster(), still);
-                                                  });
+        bool frame_cast = false;
+        const auto hits = options.rsu_frames->get(key, sim::sweepFingerprint(r.lidar, still, ego, 3), [&] {
+          const auto c1 = Clock::now();
+          placeVehicle();
+          std::vector<sim::RayHit> cast_hits = sim::castSweep(r.lidar, with_vehicle.caster(), still);
+          summary.ray_casting_seconds += since(c1);
+          summary.rays += raysPerSweep(r.lidar);
+          frame_cast = true;
+          return cast_hits;
+        });
+        if (!frame_cast) ++summary.reused_sweeps;
+        const auto c1 = Clock::now();
         sim::sweepPoints(r.lidar, *hits, rng, frame_room.points);
         positionsOf(frame_room.points, frame);
+        summary.lidar_seconds += since(c1);
       } else {
+        const auto c1 = Clock::now();
         placeVehicle();
         frameOf(r.lidar, with_vehicle.caster(), pose, rng, frame_room, frame);
+        summary.ray_casting_seconds += since(c1);  // the LiDAR model's share with it
+        summary.rays += raysPerSweep(r.lidar);
       }
-      summary.ray_casting_seconds += since(c1);
-      summary.rays += raysPerSweep(r.lidar);
       // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
       std::normal_distribution<double> cam(0.0, 0.3);
       const Eigen::Vector2d reference = seen.position + Eigen::Vector2d(cam(rng), cam(rng));
@@ -491,7 +508,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       record.refusal = d.refusal;
       record.fit_points = d.fit_points;
       if (r.ideal_perception) {
+        const auto c2 = Clock::now();
         frameOf(r.ideal_lidar, ideal_world->caster(), pose, ideal_rng, frame_room, ideal_frame);
+        summary.ray_casting_seconds += since(c2);
+        summary.rays += raysPerSweep(r.ideal_lidar);
         sim::VehicleDetection di = r.ideal_perception->detect(ideal_frame, at(capture), reference, seen.yaw, ideal_world->egoBody().length,
                                                                     ideal_world->egoBody().width);
         confirm(di, r.ideal_consistency);

@@ -157,12 +157,18 @@ TEST(LogReplay, SyntheticDriveIsFusedAndScoredAgainstItsGroundTruth) {
   EXPECT_LT(mean, 0.08);
 }
 
-TEST(LogReplay, TopicReplayedThroughAnEmulatedLinkIsDelayedAndThinnedRepeatably) {
-  testing::TempDir dir;
-  const std::string log = writeSyntheticLog(dir);
+// The synthetic log's poses through a link that delays them 50 ms and loses 30 %.
+ReplayOptions poseLinkOptions() {
   ReplayOptions options;
   options.config = pipeline::parseConfig(
       "inputs:\n  /ndt_pose: {role: pose, link: {delay: 0.05, jitter: 0.0, loss: 0.3, seed: 5}}\n", "test.yaml");
+  return options;
+}
+
+TEST(LogReplay, TopicReplayedThroughAnEmulatedLinkIsDelayedAndThinnedRepeatably) {
+  testing::TempDir dir;
+  const std::string log = writeSyntheticLog(dir);
+  ReplayOptions options = poseLinkOptions();
   const ReplayResult a = replayLog(log, options), b = replayLog(log, options);
   const TopicUse& pose = topic(a, "/ndt_pose");
   EXPECT_GT(pose.link_dropped, 10u);
@@ -172,6 +178,31 @@ TEST(LogReplay, TopicReplayedThroughAnEmulatedLinkIsDelayedAndThinnedRepeatably)
   EXPECT_EQ(topic(b, "/ndt_pose").link_dropped, pose.link_dropped);
   ASSERT_EQ(a.fused.size(), b.fused.size());
   EXPECT_EQ(a.fused.back().pose.position, b.fused.back().pose.position);
+}
+
+TEST(LogReplay, AReplayEndedEarlyGivesOutWhatTheWholeReplayGaveUpToItsEnd) {
+  testing::TempDir dir;
+  const std::string log = writeSyntheticLog(dir);
+  ReplayOptions options = poseLinkOptions();
+  const ReplayResult whole = replayLog(log, options);
+  ASSERT_GT(whole.fused.size(), 100u);
+  options.until = whole.fused[whole.fused.size() / 2].stamp;
+  const ReplayResult part = replayLog(log, options);
+  // Every estimate up to the end is the whole replay's, to the bit; none after it.
+  ASSERT_FALSE(part.fused.empty());
+  EXPECT_LE(part.fused.back().stamp, options.until);
+  ASSERT_LE(part.fused.size(), whole.fused.size());
+  EXPECT_GE(part.fused.size(), whole.fused.size() / 2 - 1);
+  for (std::size_t k = 0; k < part.fused.size(); ++k) {
+    EXPECT_EQ(part.fused[k].stamp, whole.fused[k].stamp);
+    EXPECT_EQ(part.fused[k].pose.position, whole.fused[k].pose.position) << "tick " << k;
+  }
+  // What the log counts covers all of it; the filter saw only the inputs that arrived by the end.
+  EXPECT_EQ(part.messages_read, whole.messages_read);
+  EXPECT_EQ(topic(part, "/ndt_pose").link_dropped, topic(whole, "/ndt_pose").link_dropped);
+  EXPECT_GT(part.inputs_after_until, 100u);
+  EXPECT_EQ(whole.inputs_after_until, 0u);
+  EXPECT_LT(counters(part, "/ndt_pose").applied, counters(whole, "/ndt_pose").applied);
 }
 
 TEST(LogReplay, ConfiguredRoleOnAnIncompatibleTypeIsAnErrorNamingTheTopic) {

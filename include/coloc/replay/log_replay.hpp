@@ -53,6 +53,7 @@ struct ReplayResult {
   double log_duration = 0.0;                       ///< s of log time
   double wall_seconds = 0.0;                       ///< replay time, decoding included
   std::uint64_t messages_read = 0;
+  std::uint64_t inputs_after_until = 0;            ///< inputs not given to the filter: ReplayOptions::until
   /// The log's files that were never closed, read up to their cut (ReplayOptions::recover).
   std::vector<io::RecoveredFile> recovered;
   std::vector<std::string> rejections;             ///< the first few rejection messages, for the summary
@@ -99,6 +100,11 @@ struct ReplayOptions {
   /// Read a log that was never closed (an MCAP file without its footer) up to where it stops, instead
   /// of refusing it; ReplayResult::recovered says what was read.
   bool recover = false;
+  /// Where the replay ends, on the stamp clock (0: at the log's end). Inputs that arrive later (after
+  /// the emulated link's delay) are not given to the filter, so what it gave out up to then is what a
+  /// replay of the whole log gives; what counts the log (messages read, link drops) covers all of it.
+  /// For a run whose results all lie before some instant: the rest of the drive is not computed.
+  Stamp until = 0;
 };
 
 /// Throws coloc::Error if the log cannot be read at all; bad messages inside it are counted, not fatal.

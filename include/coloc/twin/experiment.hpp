@@ -61,8 +61,8 @@ inline constexpr const char* kNextPerfect = "next drive, perfect RSU";
 
 struct ExperimentTiming {
   double total = 0.0, survey = 0.0, simulation = 0.0, replay = 0.0;  ///< s; replay summed over the jobs
-  double ray_casting = 0.0, perception = 0.0;                         ///< s, within simulation
-  std::uint64_t rays = 0, replays = 0;
+  double ray_casting = 0.0, lidar = 0.0, perception = 0.0;            ///< s, within simulation (TwinRecordingSummary's)
+  std::uint64_t rays = 0, reused_sweeps = 0, replays = 0;           ///< rays cast; sweeps and frames taken from an earlier drive's
   double driven_seconds = 0.0;  ///< s of simulated driving
 };
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "coloc/core/time.hpp"
 #include "coloc/rsu_client/commissioning.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
@@ -63,8 +64,12 @@ struct RsuFrameRecord {
 
 struct TwinRecordingSummary {
   double drive_seconds = 0.0, wall_seconds = 0.0;
-  double map_seconds = 0.0, ray_casting_seconds = 0.0, perception_seconds = 0.0;
-  std::uint64_t rays = 0, scans = 0, fixes = 0, fixes_lost = 0;
+  double map_seconds = 0.0, perception_seconds = 0.0;
+  double ray_casting_seconds = 0.0;  ///< casting the rays of the sweeps not taken from a cache (and the scene's moves for them)
+  double lidar_seconds = 0.0;        ///< the LiDAR model on the hits: noise and dropouts, every sweep
+  std::uint64_t rays = 0;            ///< rays cast
+  std::uint64_t reused_sweeps = 0;   ///< sweeps and frames whose hits came from TwinRecordingOptions' caches
+  std::uint64_t scans = 0, fixes = 0, fixes_lost = 0;
   std::string map_dir;  ///< where the map the log goes with is
   /// Per RSU id: each fix's error (x, y) against ground truth, whether the link delivered it or not.
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
@@ -72,6 +77,8 @@ struct TwinRecordingSummary {
   /// vehicle's true position and velocity at the fix's stamp: what commissioning the RSU against a
   /// reference vehicle's RTK/INS log takes.
   std::map<std::string, std::vector<rsu_client::CommissioningSample>> fix_samples;
+  /// The vehicle's true position at every ground-truth sample the log has (100 Hz).
+  std::vector<std::pair<Stamp, Eigen::Vector2d>> truth;
   /// Each odometry sample: (measured speed, true speed, measured yaw rate, true yaw rate).
   std::vector<Eigen::Vector4d> odometry;
   /// Per RSU id: every frame within its coverage.
