@@ -172,6 +172,10 @@ void fillRun(ExperimentRun& run, const std::vector<io::TrajectoryPoint>& ground_
   }
 }
 
+// The calibration study's second drive, past the same miscalibrated RSUs: its replays are the runs
+// kNextMiscalibrated, kNextCalibrated and kNextPerfect.
+constexpr const char* kNextDrive = "next drive";
+
 // Whether every figure the report draws from a run lies within the RSUs' coverage: the network grid
 // (Tables II and III), the calibration study's next drives, and Table I's second covariance unless the
 // sweeps table lists it over all samples too. Such a run need not be replayed past coverage.
@@ -377,8 +381,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   if (config.calibration)
     for (std::size_t s = 0; s < config.sites.size(); ++s) {
       drives.push_back({s, kCalibrationTrial, kCalibrationDrive, 0.0, 0.0});
-      drives.push_back({s, kNextTrial, kNextMiscalibrated, 0.0, 0.0});
-      drives.push_back({s, kNextTrial, kNextPerfect, 0.0, 0.0});
+      drives.push_back({s, kNextTrial, kNextDrive, 0.0, 0.0});
     }
   // Per site and LiDAR, the registry the calibration drive found; per site and RSU, the entry the noise
   // calibration drive found (commissioning), which the evaluated drives use.
@@ -447,17 +450,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       r.variant = drive.variant;
       r.name = r.scenario.name + (drive.variant == kNoiseCalibrationDrive ? "/noise_calibration_drive"
                                   : drive.variant == kCalibrationDrive    ? "/calibration_drive"
-                                  : drive.variant == kNextPerfect         ? "/next_drive_perfect_rsu"
-                                                                          : "/next_drive_miscalibrated");
-      if (drive.variant == kCalibrationDrive || drive.variant == kNextMiscalibrated)
+                                                                          : "/next_drive");
+      if (drive.variant == kCalibrationDrive || drive.variant == kNextDrive)
         for (sim::ScenarioRsu& rsu : r.scenario.rsus) {
           rsu.survey_error = Eigen::Vector3d(config.calibration_error[0], config.calibration_error[1], config.calibration_error[2] * M_PI / 180.0);
           rsu.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
-        }
-      if (drive.variant == kNextPerfect)
-        for (sim::ScenarioRsu& rsu : r.scenario.rsus) {
-          rsu.survey_error.setZero();
-          rsu.clock_offset = 0.0;
         }
     }
     const auto t0 = Clock::now();
@@ -470,6 +467,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     r.options.ideal_comparison = drive.variant == kNoiseCalibrationDrive && !config.ideal_twin;
     r.options.write_log = config.recordings;
     r.options.keep_log = true;
+    // The next drive past the miscalibrated RSUs also carries what they would send perfectly surveyed
+    // and synchronised: the same drive for the perfect RSU's replays (the survey and the clock are not
+    // where the LiDAR is, only where its fixes are said to be, and when).
+    r.options.perfect_rsus = drive.variant == kNextDrive;
     r.summary = recordTwin(r.scenario, r.options);
     r.seconds = since(t0);
     return r;
@@ -673,9 +674,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));
         jobs.back().calibrate = true;
       }
-    } else if (drive.variant == kNextMiscalibrated) {
+    } else if (drive.variant == kNextDrive) {
       for (const std::string& lidar : config.lidars) {
-        jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));
+        jobs.push_back(makeJob(lidar, 0.0, 0.0, kNextMiscalibrated, main_covariance));
         const auto found = calibrated_registries.find({drive.site, lidar});
         if (found == calibrated_registries.end()) continue;
         // Each RSU with the calibration the calibration drive found for it, where it found one.
@@ -686,6 +687,31 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         calibrated.registry = rsu_client::RsuRegistry(rsus, rsu_client::CovariancePlacement::kPublished);
         jobs.push_back(std::move(calibrated));
       }
+      // The same RSUs perfect: their twins' topics fused under their twins' ids, the RSUs' own ignored.
+      for (const std::string& lidar : config.lidars) {
+        Job perfect = makeJob(lidar, 0.0, 0.0, kNextPerfect, main_covariance);
+        std::vector<rsu_client::RsuInfo> twins;
+        perfect.fix_topics.clear();
+        for (const sim::ScenarioRsu& r : scenario.rsus) {
+          const std::string own = rsu_client::fixTopic(r.id), twin = rsu_client::fixTopic(perfectRsuId(r.id));
+          perfect.config.inputs[twin] = perfect.config.inputs[own];
+          perfect.config.inputs[own] = pipeline::InputConfig();
+          if (r.lidar_model != lidar) continue;
+          sim::ScenarioRsu exact = r;
+          exact.id = perfectRsuId(r.id);
+          exact.survey_error.setZero();
+          exact.clock_offset = 0.0;
+          rsu_client::RsuInfo info = registryEntry(exact);
+          info.calibrated_variance = perfect.registry->find(r.id)->calibrated_variance;
+          twins.push_back(info);
+          perfect.fix_topics.push_back(twin);
+        }
+        perfect.registry = rsu_client::RsuRegistry(twins, rsu_client::CovariancePlacement::kPublished);
+        jobs.push_back(std::move(perfect));
+      }
+      // The twins' topics are not the other replays' inputs.
+      for (Job& j : jobs)
+        for (const sim::ScenarioRsu& r : scenario.rsus) j.config.inputs.emplace(rsu_client::fixTopic(perfectRsuId(r.id)), pipeline::InputConfig());
     } else {
       if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
       for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));

@@ -636,7 +636,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   if (!calibration_md.str().empty())
     md << "## RSU self-calibration\n\nEvery RSU of the site miscalibrated (its surveyed pose and clock); one drive past it calibrates it "
           "(`coloc smooth --calibrate-rsus`, anchored by NDT), and the filter replays a second drive with the registry as surveyed, with the "
-          "calibration found, and past a perfect RSU (same drive). Errors: plain mean within coverage.\n\n"
+          "calibration found, and with the fixes the same RSUs would have sent on that drive perfectly surveyed and synchronised (the twin "
+          "records both). Errors: plain mean within coverage.\n\n"
        << calibration_md.str() << "\n";
   if (!sources_md.str().empty())
     md << "## Error sources: fix error against distance\n\nEach site's noise calibration drive, every RSU frame imaged twice: with "

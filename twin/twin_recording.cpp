@@ -280,6 +280,8 @@ rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& r) {
   return info;
 }
 
+std::string perfectRsuId(const std::string& id) { return id + "_perfect"; }
+
 TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordingOptions& options) {
   const auto wall_start = Clock::now();
   const std::string& out_dir = options.out_dir;
@@ -361,6 +363,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   bag.addTopic(topic("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
   bag.addTopic(topic("/ground_truth/odom", "nav_msgs/msg/Odometry"));
   for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::fixTopic(r.info.id), "geometry_msgs/msg/PoseWithCovarianceStamped"));
+  if (options.perfect_rsus)
+    for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::fixTopic(perfectRsuId(r.info.id)), "geometry_msgs/msg/PoseWithCovarianceStamped"));
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
@@ -535,7 +539,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       d.position = r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * local;
       const Eigen::Vector2d error = d.position - seen.position;
       // Stamped on the RSU's clock, with its per-frame stamp error; where the vehicle was at that stamp.
-      const double stamp_offset = r.info.clock_offset + (errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0);
+      const double jitter = errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0;
+      const double stamp_offset = r.info.clock_offset + jitter;
       const sim::VehicleState at_stamp = drive.at(capture + stamp_offset);
       summary.fix_errors[r.info.id].push_back(error);
       summary.fix_samples[r.info.id].push_back(
@@ -560,6 +565,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;
       bag.write(rsu_client::fixTopic(r.info.id), *delivered, io::encodePoseWithCovarianceStamped(fix));
       ++summary.fixes;
+      if (options.perfect_rsus) {
+        // Through the true pose, as the same expression computes it with a survey error of zero.
+        const Eigen::Vector2d perfect = r.info.position + true_yaw * local;
+        fix.header.stamp = at(capture) + fromSeconds(jitter);
+        fix.measurement.pose.position = {perfect.x(), perfect.y(), 0.0};
+        bag.write(rsu_client::fixTopic(perfectRsuId(r.info.id)), *delivered, io::encodePoseWithCovarianceStamped(fix));
+      }
     }
   }
   if (options.progress) options.progress(1.0);

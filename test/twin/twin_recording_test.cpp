@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "coloc/core/error.hpp"
+#include "coloc/io/ros_messages.hpp"
 #include "coloc/replay/replay_cache.hpp"
+#include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/sim/scene.hpp"
 #include "coloc/twin/twin_recording.hpp"
 #include "temp_dir.hpp"
@@ -16,11 +18,15 @@
 namespace coloc::twin {
 namespace {
 
-TEST(TwinRecording, ScansKeptInMemoryAreWhatAReplayDecodesFromTheWrittenLog) {
+sim::Scenario smallSite() {
   std::ifstream in(COLOC_SOURCE_DIR "/test/tools/small_site.yaml");
   std::stringstream text;
   text << in.rdbuf();
-  sim::Scenario scenario = sim::parseScenario(text.str(), "small_site.yaml");
+  return sim::parseScenario(text.str(), "small_site.yaml");
+}
+
+TEST(TwinRecording, ScansKeptInMemoryAreWhatAReplayDecodesFromTheWrittenLog) {
+  sim::Scenario scenario = smallSite();
   testing::TempDir dir;
   TwinRecordingOptions options;
   options.out_dir = (dir.path() / "drive").string();
@@ -48,6 +54,58 @@ TEST(TwinRecording, ScansKeptInMemoryAreWhatAReplayDecodesFromTheWrittenLog) {
     ++scans;
   }
   EXPECT_GT(scans, 40);  // 60 m at 8 m/s, 10 Hz
+}
+
+std::vector<const io::BagMessage*> onTopic(const replay::RecordedLog& log, const std::string& topic) {
+  std::vector<const io::BagMessage*> found;
+  for (const io::BagMessage& m : log.messages())
+    if (m.topic == topic) found.push_back(&m);
+  return found;
+}
+
+TEST(TwinRecording, AnRsusPerfectTwinSendsWhatTheSameRsuPerfectlySurveyedAndSynchronisedSendsOnTheSameDrive) {
+  testing::TempDir dir;
+  TwinRecordingOptions options;
+  options.perception_ablation = false;
+  options.write_log = false;
+  options.keep_log = true;
+  // Past the RSU miscalibrated (15 cm, -10 cm, 0.5 deg, 10 ms), with its perfect twin.
+  sim::Scenario off = smallSite();
+  off.rsus[0].survey_error = Eigen::Vector3d(0.15, -0.10, 0.5 * M_PI / 180.0);
+  off.rsus[0].clock_offset = 0.010;
+  options.out_dir = (dir.path() / "miscalibrated").string();
+  options.perfect_rsus = true;
+  const TwinRecordingSummary with_twin = recordTwin(off, options);
+  // The same drive past the RSU perfect, without a twin.
+  sim::Scenario exact = smallSite();
+  options.out_dir = (dir.path() / "perfect").string();
+  options.perfect_rsus = false;
+  const TwinRecordingSummary perfect = recordTwin(exact, options);
+  const std::string id = exact.rsus[0].id;
+  const auto twin = onTopic(*with_twin.log, rsu_client::fixTopic(perfectRsuId(id)));
+  const auto own = onTopic(*with_twin.log, rsu_client::fixTopic(id));
+  const auto expected = onTopic(*perfect.log, rsu_client::fixTopic(id));
+  ASSERT_GT(expected.size(), 20u);
+  ASSERT_EQ(twin.size(), expected.size());
+  ASSERT_EQ(own.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(twin[i]->log_time, expected[i]->log_time) << "fix " << i;
+    EXPECT_EQ(twin[i]->data, expected[i]->data) << "fix " << i;  // the same position and stamp, to the bit
+    // The RSU's own fix is where its survey says, 10 ms later on its clock.
+    const io::StampedPose a = std::get<io::StampedPose>(io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, own[i]->data));
+    const io::StampedPose b = std::get<io::StampedPose>(io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, twin[i]->data));
+    EXPECT_NEAR(a.header.stamp - b.header.stamp, 10'000'000, 1);
+    const double shift = (a.measurement.pose.position - b.measurement.pose.position).head<2>().norm();
+    EXPECT_GT(shift, 0.10) << "fix " << i;
+    EXPECT_LT(shift, 0.18 + 0.5 * M_PI / 180.0 * 60.0) << "fix " << i;  // 18 cm and 0.5 deg at up to 60 m
+  }
+  // Everything else on the drive is the same.
+  for (const std::string topic : {"/points", "/vehicle/twist", "/ground_truth/odom"}) {
+    const auto a = onTopic(*with_twin.log, topic), b = onTopic(*perfect.log, topic);
+    ASSERT_EQ(a.size(), b.size()) << topic;
+    if (topic != "/points")
+      for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i]->data, b[i]->data) << topic << " message " << i;
+  }
 }
 
 // A link or processing time out of range is refused before the drive is surveyed and simulated,

@@ -49,7 +49,15 @@ struct TwinRecordingOptions {
   bool write_log = true;
   /// Hand the log back in memory (TwinRecordingSummary::log), as a rosbag2 reader would give it.
   bool keep_log = false;
+  /// Also record each RSU's fixes as the same RSU would send them if its survey and clock were perfect:
+  /// the same frames, detections, link and stamp jitter, reported through its true pose and stamped
+  /// on the vehicle's clock, on the topic of perfectRsuId(id) (registryEntry of the RSU without its
+  /// survey error and clock offset, under that id). What a calibration is worth, on one drive.
+  bool perfect_rsus = false;
 };
+
+/// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.
+std::string perfectRsuId(const std::string& id);
 
 /// One RSU frame within coverage: what the perception made of it.
 struct RsuFrameRecord {
