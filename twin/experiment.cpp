@@ -475,12 +475,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     r.seconds = since(t0);
     return r;
   };
-  // Up to three drives are simulated ahead of the one being replayed (the calibration drives, which have
-  // no replays of their own, and the sites' first drives then run side by side; with two, the full run
-  // spent 24 s of its 198 between replay phases, with three 18 s, for 0.3 GB more at the peak). The
+  // Up to two drives are simulated ahead of the one being replayed. With three (the choice while a
+  // replay took longer), the quick run took as long (31.3-32.5 s against 30.9-31.3 s) and the full run
+  // with the sweeps too (134.5 s against 135.3 s), for 0.55 GB more at the peak (4.27 GB against 3.73). The
   // first drive of a site surveys its map, which the site's later drives share: none of them starts
   // before that map is noted.
-  constexpr std::size_t kSimulatedAhead = 3;
+  constexpr std::size_t kSimulatedAhead = 2;
   std::deque<std::future<Recorded>> ahead;
   std::size_t launched = 0;
   auto launch = [&](std::size_t consumed) {
