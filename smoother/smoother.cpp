@@ -146,6 +146,68 @@ struct CalibratedTwistResidual {
   }
 };
 
+// The twist residual with its derivatives written out. It is linear in the two states (bilinear with
+// the odometry's calibration), there is one per twist, and automatic differentiation through 16 or 18
+// dual numbers was a tenth of a solve. The derivatives are the ones the dual numbers carry, computed
+// in the same order: the same bits.
+class TwistCost final : public ceres::CostFunction {
+ public:
+  TwistCost(const TwistResidual& r, bool calibrated) : r_(r), calibrated_(calibrated) {
+    set_num_residuals(r.m);
+    mutable_parameter_block_sizes()->push_back(kState);
+    mutable_parameter_block_sizes()->push_back(kState);
+    if (calibrated) mutable_parameter_block_sizes()->push_back(2);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* a = parameters[0];
+    const double* b = parameters[1];
+    const double scale = calibrated_ ? parameters[2][0] : 1.0, bias = calibrated_ ? parameters[2][1] : 0.0;
+    // Per component: the error and its derivatives by a[c], b[c], the scale and the bias.
+    double e[2], by_a[2], by_b[2], by_scale[2], by_bias[2];
+    for (int j = 0; j < r_.m; ++j) {
+      const int c = r_.component[j];
+      const double state = (1.0 - r_.w) * a[c] + r_.w * b[c];
+      if (c == 4) {
+        e[j] = scale * state - r_.value[j];
+        by_a[j] = scale * (1.0 - r_.w), by_b[j] = scale * r_.w, by_scale[j] = state, by_bias[j] = 0.0;
+      } else {
+        e[j] = state + bias - r_.value[j];
+        by_a[j] = 1.0 - r_.w, by_b[j] = r_.w, by_scale[j] = 0.0, by_bias[j] = 1.0;
+      }
+    }
+    whiten(r_.whitening, e, r_.m, residuals);
+    if (!jacobians) return true;
+    // Row i of a Jacobian: sum over j <= i of L(i, j) times component j's derivative, as whiten sums.
+    const auto row = [&](int i, const double* d) {
+      double sum = 0.0;
+      for (int j = 0; j <= i; ++j) sum += r_.whitening(i, j) * d[j];
+      return sum;
+    };
+    for (int k = 0; k < 2; ++k) {
+      double* J = jacobians[k];
+      if (!J) continue;
+      std::fill(J, J + r_.m * kState, 0.0);
+      for (int i = 0; i < r_.m; ++i)
+        for (int j = 0; j <= i; ++j) {
+          // Each component's derivative lies in its own column; a column two components share (the
+          // same state twice) does not occur.
+          double d[2] = {0.0, 0.0};
+          d[j] = k == 0 ? by_a[j] : by_b[j];
+          J[i * kState + r_.component[j]] += row(i, d);
+        }
+    }
+    if (calibrated_ && jacobians[2]) {
+      double* J = jacobians[2];
+      for (int i = 0; i < r_.m; ++i) J[i * 2 + 0] = row(i, by_scale), J[i * 2 + 1] = row(i, by_bias);
+    }
+    return true;
+  }
+
+ private:
+  TwistResidual r_;
+  bool calibrated_;
+};
+
 // What an odometry's calibration is before the drive says otherwise: scale 1, no bias.
 struct OdometryPrior {
   double inverse_sd_scale, inverse_sd_bias;
@@ -191,6 +253,31 @@ struct BiasProcess {
     r[1] = (b[7] - phi * a[7]) * inverse_sigma;
     return true;
   }
+};
+
+// The pose bias's process, linear, with its derivatives written out (one per tick).
+class BiasProcessCost final : public ceres::SizedCostFunction<2, kState, kState> {
+ public:
+  explicit BiasProcessCost(const BiasProcess& p) : p_(p) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* a = parameters[0];
+    const double* b = parameters[1];
+    residuals[0] = (b[6] - p_.phi * a[6]) * p_.inverse_sigma;
+    residuals[1] = (b[7] - p_.phi * a[7]) * p_.inverse_sigma;
+    if (!jacobians) return true;
+    for (int k = 0; k < 2; ++k) {
+      double* J = jacobians[k];
+      if (!J) continue;
+      std::fill(J, J + 2 * kState, 0.0);
+      const double d = (k == 0 ? -p_.phi : 1.0) * p_.inverse_sigma;
+      J[0 * kState + 6] = d;
+      J[1 * kState + 7] = d;
+    }
+    return true;
+  }
+
+ private:
+  BiasProcess p_;
 };
 
 struct BiasPrior {
@@ -503,10 +590,10 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
             new ceres::AutoDiffCostFunction<OdometryPrior, 2, 2>(new OdometryPrior{1.0 / o.odometry_scale_sd, 1.0 / o.odometry_yaw_rate_bias_sd}),
             nullptr, it->second.data());
       id = problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<CalibratedTwistResidual, ceres::DYNAMIC, kState, kState, 2>(new CalibratedTwistResidual{r}, t.m), l,
+          new TwistCost(r, true), l,
           blockOf(k), blockOf(k + 1), it->second.data());
     } else {
-      id = problem.AddResidualBlock(new ceres::AutoDiffCostFunction<TwistResidual, ceres::DYNAMIC, kState, kState>(new TwistResidual(r), t.m), l,
+      id = problem.AddResidualBlock(new TwistCost(r, false), l,
                                     blockOf(k), blockOf(k + 1));
     }
     added.push_back({id, &t.source, t.stamp, delta2, -1, l});
@@ -528,7 +615,7 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     for (std::size_t k = 0; k + 1 < n; ++k) {
       auto* l = used ? new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP) : nullptr;
       const ceres::ResidualBlockId id = problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<BiasProcess, 2, kState, kState>(new BiasProcess{phi, inverse_sigma}), l, blockOf(k), blockOf(k + 1));
+          new BiasProcessCost(BiasProcess{phi, inverse_sigma}), l, blockOf(k), blockOf(k + 1));
       if (used) added.push_back({id, &kBiasSource, result.states[k].stamp, 0.0, -1, l, false});
     }
   }
