@@ -304,9 +304,13 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     events.erase(later, events.end());
   }
   drive(events, options, std::move(registry), result);
-  if (result.fused.empty())
+  if (result.fused.empty()) {
+    const std::string ended = result.inputs_after_until ? "; the replay ended at stamp " + formatSeconds(options.until) + " (until), before " +
+                                                              std::to_string(result.inputs_after_until) + " of its inputs"
+                                                        : std::string();
     throw Error(log_path + ": nothing fused: no input gave the filter a pose it could start from or accept (" +
-                std::to_string(result.messages_read) + " messages read). The log holds:\n" + describeTopics(result.topics));
+                std::to_string(result.messages_read) + " messages read" + ended + "). The log holds:\n" + describeTopics(result.topics));
+  }
   if (!result.fused.empty()) {
     result.first_stamp = result.fused.front().stamp;
     result.last_stamp = result.fused.back().stamp;

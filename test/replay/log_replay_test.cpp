@@ -203,6 +203,15 @@ TEST(LogReplay, AReplayEndedEarlyGivesOutWhatTheWholeReplayGaveUpToItsEnd) {
   EXPECT_GT(part.inputs_after_until, 100u);
   EXPECT_EQ(whole.inputs_after_until, 0u);
   EXPECT_LT(counters(part, "/ndt_pose").applied, counters(whole, "/ndt_pose").applied);
+  // Ended before any input, nothing is fused: the error says where the replay ended.
+  options.until = whole.fused.front().stamp - 10 * kNanosPerSecond;
+  try {
+    replayLog(log, options);
+    FAIL() << "a replay ended before its first input fused something";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing fused"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the replay ended at stamp " + formatSeconds(options.until) + " (until)"), std::string::npos) << e.what();
+  }
 }
 
 TEST(LogReplay, ConfiguredRoleOnAnIncompatibleTypeIsAnErrorNamingTheTopic) {
