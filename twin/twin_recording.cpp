@@ -290,6 +290,11 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   rsu_client::checkLinkConfig(options.link);
   if (!(std::isfinite(options.rsu_processing) && options.rsu_processing >= 0.0))
     throw Error("twin: the RSU's processing time must be a finite number of seconds >= 0");
+  if (options.perfect_rsus)
+    for (const sim::ScenarioRsu& a : scenario.rsus)
+      for (const sim::ScenarioRsu& b : scenario.rsus)
+        if (perfectRsuId(a.id) == b.id)
+          throw Error("twin: RSU " + a.id + "'s perfect twin would send on RSU " + b.id + "'s topic: rename " + b.id + " to record perfect twins");
   fs::create_directories(out_dir);
   TwinRecordingSummary summary;
 

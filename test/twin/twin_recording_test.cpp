@@ -134,5 +134,24 @@ TEST(TwinRecording, RefusesALinkOrProcessingTimeOutOfRangeBeforeSimulating) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "drive" / "map"));  // refused before the survey
 }
 
+TEST(TwinRecording, RefusesPerfectTwinsWhoseTopicAnotherRsuUsesBeforeSimulating) {
+  sim::Scenario scenario = smallSite();
+  sim::ScenarioRsu other = scenario.rsus[0];
+  other.id = perfectRsuId(scenario.rsus[0].id);
+  other.position.x() += 20.0;
+  scenario.rsus.push_back(other);
+  testing::TempDir dir;
+  TwinRecordingOptions options;
+  options.out_dir = (dir.path() / "drive").string();
+  options.perfect_rsus = true;
+  try {
+    recordTwin(scenario, options);
+    FAIL() << "two RSUs on one topic were recorded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("RSU rsu_a's perfect twin would send on RSU rsu_a_perfect's topic"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "drive" / "map"));
+}
+
 }  // namespace
 }  // namespace coloc::twin
