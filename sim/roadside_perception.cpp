@@ -87,6 +87,7 @@ const char* toString(Refusal r) {
     case Refusal::kNotAtPosition: return "fitted vehicle away from the CAM position";
     case Refusal::kInconsistent: return "disagrees with the vehicle's track";
     case Refusal::kCornerNotSeen: return "one face seen, no corner to place the vehicle on";
+    case Refusal::kBeyondOracleLimit: return "beyond the oracle limit from the true position (analysis bound)";
   }
   return "?";
 }

@@ -471,6 +471,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     // and synchronised: the same drive for the perfect RSU's replays (the survey and the clock are not
     // where the LiDAR is, only where its fixes are said to be, and when).
     r.options.perfect_rsus = drive.variant == kNextDrive;
+    r.options.oracle_fix_limit = config.oracle_fix_limit;
     r.summary = recordTwin(r.scenario, r.options);
     r.seconds = since(t0);
     return r;

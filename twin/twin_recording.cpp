@@ -290,6 +290,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   rsu_client::checkLinkConfig(options.link);
   if (!(std::isfinite(options.rsu_processing) && options.rsu_processing >= 0.0))
     throw Error("twin: the RSU's processing time must be a finite number of seconds >= 0");
+  if (!(std::isfinite(options.oracle_fix_limit) && options.oracle_fix_limit >= 0.0))
+    throw Error("twin: the oracle fix limit must be a finite number of metres >= 0 (0: off)");
   if (options.perfect_rsus)
     for (const sim::ScenarioRsu& a : scenario.rsus)
       for (const sim::ScenarioRsu& b : scenario.rsus)
@@ -536,6 +538,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         keep(record);
         continue;
       }
+      const bool withheld = options.oracle_fix_limit > 0.0 && (d.position - seen.position).norm() > options.oracle_fix_limit;
       const Stamp ready = at(capture + 0.05 + options.rsu_processing);  // end of the sweep + processing
       const std::optional<Stamp> delivered = r.link.transmit(ready);
       // The RSU reports in the map frame through its surveyed pose, and stamps on its own clock.
@@ -547,6 +550,12 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const double jitter = errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0;
       const double stamp_offset = r.info.clock_offset + jitter;
       const sim::VehicleState at_stamp = drive.at(capture + stamp_offset);
+      if (withheld) {  // after the draws a sent fix makes: every other fix of the drive is as without the oracle
+        record.found = false;
+        record.refusal = sim::Refusal::kBeyondOracleLimit;
+        keep(record);
+        continue;
+      }
       summary.fix_errors[r.info.id].push_back(error);
       summary.fix_samples[r.info.id].push_back(
           {d.position, at_stamp.position, at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw))});

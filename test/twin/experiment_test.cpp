@@ -37,6 +37,7 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_FALSE(c.twist_covariance_estimated);
   EXPECT_TRUE(c.errors.empty());
   EXPECT_FALSE(c.recordings);  // the drives are replayed from memory unless asked
+  EXPECT_EQ(c.oracle_fix_limit, 0.0);  // the analysis bound is off
   EXPECT_EQ(quickExperiment(c).trials, 1);
 }
 
@@ -64,6 +65,9 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_NE(errorOf("rsu_calibration: yes\n").find("rsu_calibration: expected one of noise_drive, none"), std::string::npos);
   EXPECT_TRUE(parseExperimentConfig("recordings: true\n", "exp.yaml").recordings);
   EXPECT_NE(errorOf("recordings: often\n").find("exp.yaml:1: recordings"), std::string::npos) << errorOf("recordings: often\n");
+  EXPECT_DOUBLE_EQ(parseExperimentConfig("oracle_fix_limit: 0.02\n", "exp.yaml").oracle_fix_limit, 0.02);
+  EXPECT_NE(errorOf("oracle_fix_limit: -0.02\n").find("exp.yaml:1: oracle_fix_limit: must be in [0, 100]"), std::string::npos)
+      << errorOf("oracle_fix_limit: -0.02\n");
 }
 
 TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideIt) {

@@ -103,8 +103,62 @@ TEST(TwinRecording, AnRsusPerfectTwinSendsWhatTheSameRsuPerfectlySurveyedAndSync
   for (const std::string topic : {"/points", "/vehicle/twist", "/ground_truth/odom"}) {
     const auto a = onTopic(*with_twin.log, topic), b = onTopic(*perfect.log, topic);
     ASSERT_EQ(a.size(), b.size()) << topic;
-    if (topic != "/points")
+    if (topic != "/points") {
       for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i]->data, b[i]->data) << topic << " message " << i;
+    }
+  }
+}
+
+// The oracle bound withholds exactly the fixes farther than its limit from the truth, counts each as
+// refused with its reason, and leaves every other fix of the drive as it was, to the bit.
+TEST(TwinRecording, TheOracleLimitWithholdsExactlyTheFixesFartherThanItFromTheTruthAndNothingElse) {
+  const sim::Scenario scenario = smallSite();  // its RSU surveyed exactly: a fix's error is the perception's
+  testing::TempDir dir;
+  TwinRecordingOptions options;
+  options.perception_ablation = false;
+  options.write_log = false;
+  options.keep_log = true;
+  options.out_dir = (dir.path() / "all").string();
+  const TwinRecordingSummary all = recordTwin(scenario, options);
+  const std::string id = scenario.rsus[0].id;
+  const std::vector<Eigen::Vector2d>& errors = all.fix_errors.at(id);
+  ASSERT_GT(errors.size(), 20u);
+  std::vector<double> sizes;
+  for (const Eigen::Vector2d& e : errors) sizes.push_back(e.norm());
+  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+  const double limit = sizes[sizes.size() / 2];  // about half the fixes beyond it
+  options.out_dir = (dir.path() / "oracle").string();
+  options.oracle_fix_limit = limit;
+  const TwinRecordingSummary bounded = recordTwin(scenario, options);
+
+  const auto sent = onTopic(*all.log, rsu_client::fixTopic(id)), kept = onTopic(*bounded.log, rsu_client::fixTopic(id));
+  ASSERT_EQ(sent.size(), errors.size());  // no link loss: every fix is on the log
+  std::size_t k = 0, beyond = 0;
+  for (std::size_t i = 0; i < sent.size(); ++i) {
+    if (errors[i].norm() > limit) {
+      ++beyond;
+      continue;
+    }
+    ASSERT_LT(k, kept.size()) << "fix " << i << " within the limit was withheld";
+    EXPECT_EQ(kept[k]->log_time, sent[i]->log_time) << "fix " << i;
+    EXPECT_EQ(kept[k]->data, sent[i]->data) << "fix " << i;
+    ++k;
+  }
+  EXPECT_EQ(k, kept.size());
+  EXPECT_GT(beyond, 5u);
+  for (const Eigen::Vector2d& e : bounded.fix_errors.at(id)) EXPECT_LE(e.norm(), limit);
+  std::size_t refused = 0;
+  for (const RsuFrameRecord& f : bounded.rsu_frames.at(id)) refused += f.refusal == sim::Refusal::kBeyondOracleLimit ? 1 : 0;
+  EXPECT_EQ(refused, beyond);
+  EXPECT_EQ(bounded.rsu_frames.at(id).size(), all.rsu_frames.at(id).size());  // every frame accounted for
+
+  options.oracle_fix_limit = -0.1;
+  options.out_dir = (dir.path() / "negative").string();
+  try {
+    recordTwin(scenario, options);
+    FAIL() << "a negative oracle limit was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("oracle fix limit must be a finite number of metres >= 0"), std::string::npos) << e.what();
   }
 }
 

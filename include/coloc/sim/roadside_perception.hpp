@@ -60,9 +60,12 @@ enum class Refusal {
   kNotAtPosition,  ///< the fitted vehicle is farther from the CAM's position than attribution_radius
   kInconsistent,   ///< disagrees with the vehicle's track (FixConsistency), or has none to agree with
   kCornerNotSeen,  ///< one face seen: no corner to rest the vehicle's box on
+  /// Not the perception's: the twin's analysis bound (TwinRecordingOptions::oracle_fix_limit) withheld
+  /// a fix farther than its limit from the vehicle's true position, which no RSU can know.
+  kBeyondOracleLimit,
 };
 const char* toString(Refusal r);
-inline constexpr int kRefusalCount = 8;
+inline constexpr int kRefusalCount = 9;
 
 struct VehicleDetection {
   bool found = false;

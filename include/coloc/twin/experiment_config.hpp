@@ -89,6 +89,9 @@ struct ExperimentConfig {
   bool calibrate_rsus = true;
   std::vector<double> calibration_error = {0.15, 0.0, 0.5};  ///< [dx m, dy m, dyaw deg], surveyed minus true
   double calibration_clock_offset_ms = 20.0;                 ///< the RSU's clock minus the vehicle's
+  /// An analysis bound on every drive (TwinRecordingOptions::oracle_fix_limit): the RSUs withhold each
+  /// fix farther than this from the vehicle's true position, which no RSU can know. m; 0: off.
+  double oracle_fix_limit = 0.0;
 };
 
 /// The quick mode: one trial of everything, for a first look in a minute or two.

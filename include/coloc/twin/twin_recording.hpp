@@ -54,6 +54,11 @@ struct TwinRecordingOptions {
   /// on the vehicle's clock, on the topic of perfectRsuId(id) (registryEntry of the RSU without its
   /// survey error and clock offset, under that id). What a calibration is worth, on one drive.
   bool perfect_rsus = false;
+  /// An analysis bound, not a perception: each RSU withholds every fix whose position (before its
+  /// survey error) is farther than this from the vehicle's true position, which no RSU can know; such
+  /// frames count as refused (sim::Refusal::kBeyondOracleLimit). What a perception that never sent a
+  /// fix of the tails would give. m; 0: off.
+  double oracle_fix_limit = 0.0;
 };
 
 /// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.
