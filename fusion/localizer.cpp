@@ -66,6 +66,7 @@ struct Localizer::Impl {
     SourceKind kind;
     SourceCounters counters;
     int gated_in_a_row = 0;
+    int smoothing_steps = 0;  ///< 0: the configuration's for the kind
   };
   // A measurement still being applied over its smoothing steps.
   struct Active {
@@ -103,7 +104,8 @@ struct Localizer::Impl {
         twist_gate(gateThresholds(c.twist_gate_alpha)),
         future_tolerance(fromSeconds(c.future_tolerance)) {}
 
-  SourceId add(const std::string& name, SourceKind kind) {
+  SourceId add(const std::string& name, SourceKind kind, int smoothing_steps = 0) {
+    if (smoothing_steps < 0) throw Error("source '" + name + "': smoothing_steps must be >= 1 (0: the configuration's), got " + std::to_string(smoothing_steps));
     if (auto it = by_name.find(name); it != by_name.end()) {
       if (sources[it->second].kind != kind)
         throw Error("source '" + name + "' is already registered as a " +
@@ -111,6 +113,7 @@ struct Localizer::Impl {
       return it->second;
     }
     sources.push_back({name, kind, {}});
+    sources.back().smoothing_steps = smoothing_steps;
     by_name.emplace(name, static_cast<SourceId>(sources.size() - 1));
     return static_cast<SourceId>(sources.size() - 1);
   }
@@ -146,12 +149,13 @@ struct Localizer::Impl {
     return report(Verdict{outcome, Reason::kNone, inputKind(id), sources[id].name, stamp, ticks_back, d2, std::move(note)});
   }
 
-  int smoothingSteps(SourceKind kind) const {
-    return kind == SourceKind::kPose ? config.pose_smoothing_steps : config.twist_smoothing_steps;
+  int smoothingSteps(const Source& s) const {
+    if (s.smoothing_steps > 0) return s.smoothing_steps;
+    return s.kind == SourceKind::kPose ? config.pose_smoothing_steps : config.twist_smoothing_steps;
   }
-  int queueCapacity(SourceKind kind) const {
-    const int queue = kind == SourceKind::kPose ? config.max_pose_queue_size : config.max_twist_queue_size;
-    return std::max(queue, smoothingSteps(kind));
+  int queueCapacity(const Source& s) const {
+    const int queue = s.kind == SourceKind::kPose ? config.max_pose_queue_size : config.max_twist_queue_size;
+    return std::max(queue, smoothingSteps(s));
   }
 
   // Applies the remaining smoothing uses of active[i] at once (same total information) and drops it.
@@ -198,7 +202,7 @@ struct Localizer::Impl {
     } else {
       src.gated_in_a_row = 0;
     }
-    const int steps = smoothingSteps(src.kind);
+    const int steps = smoothingSteps(src);
     // The tick must stay in the history for all uses; fewer, heavier uses carry the same information.
     const int uses = std::max(1, std::min(steps, 1 + config.history_steps - back));
     record.scale = uses;
@@ -211,7 +215,7 @@ struct Localizer::Impl {
       std::size_t oldest = active.size();
       for (std::size_t i = 0; i < active.size(); ++i)
         if (active[i].source == id && queued++ == 0) oldest = i;
-      if (queued >= queueCapacity(src.kind)) fold(oldest);
+      if (queued >= queueCapacity(src)) fold(oldest);
       active.push_back({id, stamp, record, uses - 1, uses});
     }
     return accept(id, stamp, Outcome::kApplied, back, d2, note);
@@ -389,7 +393,7 @@ Localizer::~Localizer() = default;
 Localizer::Localizer(Localizer&&) noexcept = default;
 Localizer& Localizer::operator=(Localizer&&) noexcept = default;
 
-SourceId Localizer::addPoseSource(const std::string& name) { return impl_->add(name, SourceKind::kPose); }
+SourceId Localizer::addPoseSource(const std::string& name, int smoothing_steps) { return impl_->add(name, SourceKind::kPose, smoothing_steps); }
 SourceId Localizer::addTwistSource(const std::string& name) { return impl_->add(name, SourceKind::kTwist); }
 
 std::optional<SourceId> Localizer::findSource(std::string_view name) const {

@@ -238,6 +238,9 @@ const std::vector<Key>& keys() {
       {"rsu", "future_tolerance", "s", "fixes stamped further than this after their arrival are refused (from_future)",
        [](const C& c) { return show(c.rsu.checks.future_tolerance); },
        [](const R& r, const N& n, const S& k, C& c) { c.rsu.checks.future_tolerance = r.inRange(n, k, 0.0, 10.0); }},
+      {"rsu", "smoothing_steps", "ticks", "each fix is applied over this many ticks, each with covariance x steps; 0 = fusion.pose_smoothing_steps",
+       [](const C& c) { return show(c.rsu.smoothing_steps); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.smoothing_steps = static_cast<int>(r.integer(n, k, 0, 50)); }},
       // ---- pipeline
       {"pipeline", "initial_pose", "m, rad", "[x, y, z, yaw] to start the filter at the first input (NDT needs a first guess); null = from the first full pose",
        [](const C& c) { return c.pipeline.initial_pose ? yamlList(*c.pipeline.initial_pose) : S("null"); },

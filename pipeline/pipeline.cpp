@@ -206,12 +206,12 @@ struct Pipeline::Impl {
     if (options.registry) {
       checker.emplace(std::move(*options.registry), config.rsu.checks);
       for (const rsu_client::RsuInfo& rsu : checker->registry().rsus())
-        fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose);
+        fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose, config.rsu.smoothing_steps);
     }
   }
 
-  fusion::SourceId addSource(const std::string& name, fusion::SourceKind kind) {
-    const fusion::SourceId id = kind == fusion::SourceKind::kPose ? localizer.addPoseSource(name) : localizer.addTwistSource(name);
+  fusion::SourceId addSource(const std::string& name, fusion::SourceKind kind, int smoothing_steps = 0) {
+    const fusion::SourceId id = kind == fusion::SourceKind::kPose ? localizer.addPoseSource(name, smoothing_steps) : localizer.addTwistSource(name);
     if (static_cast<std::size_t>(id) >= source_names.size()) source_names.resize(id + 1);
     source_names[id] = name;
     return id;

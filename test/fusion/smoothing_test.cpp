@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "coloc/core/error.hpp"
 #include "drive.hpp"
 
 namespace coloc::fusion {
@@ -47,6 +48,37 @@ TEST(Smoothing, EstimateMovesGraduallyWhileAPoseIsBeingApplied) {
   EXPECT_GT(first_step, 0.0);
   // A fifth of the information: gain P / (P + 5R) instead of P / (P + R), here about 0.66 of the full step.
   EXPECT_LT(first_step, 0.8 * full_step);
+}
+
+TEST(Smoothing, ASourceRegisteredWithItsOwnStepsIsAppliedOverThemWhileTheOthersKeepTheConfigurations) {
+  const Drive drive;
+  // Five steps for every pose, but the "fix" source's whole: it must move the estimate as a filter
+  // whose every pose is whole does, and NDT's must still come in gradually.
+  Localizer mixed = startedLocalizer(withPoseSmoothing(5)), single = startedLocalizer(withPoseSmoothing(1));
+  mixed.addPoseSource("fix", 1);
+  single.addPoseSource("fix");
+  EXPECT_EQ(mixed.addPoseSource("fix", 3), mixed.addPoseSource("fix"));  // registered again: as it was
+  for (int k = 1; k <= 30; ++k) {
+    driveTick(mixed, drive, k);
+    driveTick(single, drive, k);
+    if (k == 20) {
+      PoseMeasurement jump = rsuFixAt(drive, 20);
+      jump.pose.position.x() += 0.3;
+      mixed.feedPose("fix", jump);
+      single.feedPose("fix", jump);
+      expectSameEstimate(mixed, single, 1e-12);  // whole at once, not a fifth
+    }
+  }
+  expectSameEstimate(mixed, single, 1e-12);
+  PoseMeasurement jump = ndtPoseAt(drive, 30);
+  jump.pose.position.x() += 0.3;
+  const double x_before = mixed.estimate()->state[0];
+  mixed.feedPose("ndt", jump);
+  single.feedPose("ndt", jump);
+  const double first_step = mixed.estimate()->state[0] - x_before, full_step = single.estimate()->state[0] - x_before;
+  EXPECT_GT(first_step, 0.0);
+  EXPECT_LT(first_step, 0.8 * full_step);  // NDT's pose over the configuration's five steps
+  EXPECT_THROW(mixed.addPoseSource("other", -1), Error);
 }
 
 TEST(Smoothing, QueueOverflowFoldsTheOldestPoseInsteadOfDroppingIt) {

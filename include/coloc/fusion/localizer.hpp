@@ -49,7 +49,9 @@ class Localizer {
   Localizer& operator=(Localizer&&) noexcept;
 
   /// Registers a named input. Names are unique across kinds; registering a name twice returns its id.
-  SourceId addPoseSource(const std::string& name);
+  /// `smoothing_steps`: ticks over which each of the source's poses is applied (0: the configuration's
+  /// pose_smoothing_steps); a source registered again keeps what it was registered with first.
+  SourceId addPoseSource(const std::string& name, int smoothing_steps = 0);
   SourceId addTwistSource(const std::string& name);
   std::optional<SourceId> findSource(std::string_view name) const;
 

@@ -66,6 +66,11 @@ struct RsuSection {
   /// plain pose inputs offline and there is nothing to subscribe to live.
   std::string registry;
   rsu_client::FixCheckConfig checks;
+  /// Ticks over which each fix is applied; 0: fusion.pose_smoothing_steps, as every other pose.
+  /// Autoware spreads every pose over five ticks so that NDT's pose does not jump; a centimetre fix
+  /// need not be, and applied whole its information is in the estimate four ticks sooner. On the twin
+  /// that changed nothing beyond the trials' spread (README, *Network*), so fixes stay as Autoware's poses.
+  int smoothing_steps = 0;
 };
 
 struct PipelineSection {
