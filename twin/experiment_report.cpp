@@ -448,7 +448,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     const double worst_delay = c.delays.back(), worst_loss = c.losses.back();
     by_site << "\n**At " << fmt("%.0f ms", 1e3 * worst_delay) << " and " << fmt("%.0f %% loss", 100 * worst_loss)
             << ", per site (change against the ideal network; the paper: +9.5 % with the VLP-16, +19.2 % with the VLP-32C, on its metric)**\n\n"
-            << "| site | roadside LiDAR | paper's metric | change | plain mean | change |\n|---|---|---|---|---|---|\n";
+            << "| site | roadside LiDAR | paper's metric | change (± se) | plain mean | change (± se) |\n|---|---|---|---|---|---|\n";
     for (const std::string& lidar : c.lidars) {
       const double range = rangeOf(lidar);
       struct Cell {
@@ -470,6 +470,25 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         return out;
       };
       auto change = [](double value, double reference) { return reference > 0.0 ? 100.0 * (value / reference - 1.0) : 0.0; };
+      // How far a site's change can be trusted: the standard error of the trials' own changes (each trial
+      // against its own ideal network: the same drive), "" with fewer than two trials.
+      auto standardError = [&](double delay, double loss, const std::string& site, bool paper) -> std::string {
+        std::vector<double> changes;
+        for (int t = 0; t < std::min(c.trials, c.network_trials); ++t) {
+          const ExperimentRun* a = find(results.runs, site, t, lidar, 0.0, 0.0, "");
+          const ExperimentRun* b = find(results.runs, site, t, lidar, delay, loss, "");
+          if (!a || !b) continue;
+          const ErrorInCoverage ea = errorInCoverage(*a, range, bin), eb = errorInCoverage(*b, range, bin);
+          changes.push_back(paper ? change(eb.paper, ea.paper) : change(eb.plain, ea.plain));
+        }
+        if (changes.size() < 2) return "";
+        double mean = 0.0, ss = 0.0;
+        for (double x : changes) mean += x;
+        mean /= static_cast<double>(changes.size());
+        for (double x : changes) ss += (x - mean) * (x - mean);
+        const double n = static_cast<double>(changes.size());
+        return fmt(" (± %.1f)", std::sqrt(ss / (n - 1.0) / n));
+      };
       std::vector<std::string> scopes = {""};
       for (const SiteInfo& site : results.sites) scopes.push_back(site.name);
       for (const std::string& scope : scopes) {
@@ -483,7 +502,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         if (scope.empty()) continue;
         const Cell worst = cell(worst_delay, worst_loss, scope);
         by_site << "| " << scope << " | " << lidar << fmt(" | %.2f cm", 100 * worst.paper) << fmt(" | %+.1f %%", change(worst.paper, ideal.paper))
-                << fmt(" | %.2f cm", 100 * worst.plain) << fmt(" | %+.1f %% |\n", change(worst.plain, ideal.plain));
+                << standardError(worst_delay, worst_loss, scope, true) << fmt(" | %.2f cm", 100 * worst.plain)
+                << fmt(" | %+.1f %%", change(worst.plain, ideal.plain)) << standardError(worst_delay, worst_loss, scope, false) << " |\n";
       }
       const Cell ideal = cell(0, 0, "");
       network_md << "\n**Table " << (table == 2 ? "II" : table == 3 ? "III" : std::to_string(table).c_str()) << ": NDT + " << lidar

@@ -42,4 +42,19 @@ awk -F, 'NR > 1 && $(NF-12) != "" && $(NF-9) == "\"\"" {
            if (n == 0) { print "FAIL: no network run in runs.csv"; exit 1 }
            print n " network rows, each with every sample within coverage"
          }' "$work/out/runs.csv"
-echo "the experiment wrote its tables and figures; fusion beat NDT alone"
+# The per-site change at the worst cell carries the standard error of the trials' own changes (each
+# trial against its own ideal network), recomputed here from runs.csv's paper's-metric column.
+expected=$(awk -F, 'NR > 1 && $1 == "small_site" && $(NF-12) == "VLP-32C" && $(NF-8) == "VLP-32C" && $(NF-9) == "\"\"" {
+           if ($(NF-11) == 0 && $(NF-10) == 0) ideal[$2] = $(NF-6)
+           if ($(NF-11) == 0.03 && $(NF-10) == 0.2) worst[$2] = $(NF-6)
+         }
+         END {
+           n = 0; sum = 0
+           for (t in worst) { c[n] = 100 * (worst[t] / ideal[t] - 1); sum += c[n]; n++ }
+           mean = sum / n; ss = 0
+           for (i = 0; i < n; i++) ss += (c[i] - mean) ^ 2
+           printf "(± %.1f)", sqrt(ss / (n - 1) / n)
+         }' "$work/out/runs.csv")
+row=$(grep '^| small_site | VLP-32C | [0-9.]* cm | ' "$work/out/README.md")
+echo "$row" | grep -qF "$expected" || { echo "FAIL: the per-site row '$row' does not carry the trials' standard error $expected"; exit 1; }
+echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected"

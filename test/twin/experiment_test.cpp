@@ -38,6 +38,7 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_TRUE(c.errors.empty());
   EXPECT_FALSE(c.recordings);  // the drives are replayed from memory unless asked
   EXPECT_EQ(c.oracle_fix_limit, 0.0);  // the analysis bound is off
+  EXPECT_EQ(c.network_trials, 10);  // the grid on every trial: one trial's change spreads by 5-18 points
   EXPECT_EQ(quickExperiment(c).trials, 1);
 }
 
