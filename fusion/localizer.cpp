@@ -355,8 +355,8 @@ struct Localizer::Impl {
     if (stamp < history.latestStamp()) return std::nullopt;  // older than the history
     FilterState s = history.latest();
     const double dt = toSeconds(stamp - history.latestStamp());
-    const Matrix6d A = motionJacobian(s.x, dt);
-    s.x = predictState(s.x, dt);
+    Matrix6d A;
+    s.x = predictState(s.x, dt, A);
     s.P = propagateCovariance(A, s.P, processNoise(history.options().noise, dt));
     predictAux(s, history.options().aux_proc_dev, dt);
     return describe(s, stamp);

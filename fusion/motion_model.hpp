@@ -21,10 +21,14 @@ Vector6d predictState(const Vector6d& x, double dt);
 /// d predictState / dx, evaluated at x.
 Matrix6d motionJacobian(const Vector6d& x, double dt);
 
+/// Both at once, the heading's sine and cosine taken once (the same values as the two apart).
+Vector6d predictState(const Vector6d& x, double dt, Matrix6d& jacobian);
+
 /// diag(0, 0, (yaw_c dt)^2, 0, (vx_c dt)^2, (wz_c dt)^2), Autoware's discrete process noise.
 Matrix6d processNoise(const ProcessNoise& noise, double dt);
 
-/// P' = A P A^T + Q, exploiting that A is the identity plus a few entries.
+/// P' = A P A^T + Q for A of motionJacobian's form: the identity but in the rows of x, y and yaw,
+/// which is what the product visits (half the multiplications of the dense one).
 Matrix6d propagateCovariance(const Matrix6d& A, const Matrix6d& P, const Matrix6d& Q);
 
 }  // namespace coloc::fusion

@@ -37,8 +37,8 @@ std::optional<int> StateHistory::ticksBack(Stamp stamp) const {
 void StateHistory::predictInto(const FilterState& from, Slot& into, bool first_time) const {
   FilterState& prior = into.prior;
   if (options_.relinearize || first_time) {
-    const Matrix6d A = motionJacobian(from.x, dt_);
-    prior.x = predictState(from.x, dt_);
+    Matrix6d A;
+    prior.x = predictState(from.x, dt_, A);
     prior.P = propagateCovariance(A, from.P, Q_);
     if (!options_.relinearize) {
       into.from_linearization = from.x;

@@ -28,6 +28,33 @@ TEST(MotionModel, PredictionMovesAlongBiasedHeadingAndWrapsYaw) {
   EXPECT_NEAR(next[kYaw], -M_PI + 0.09, 1e-12);
 }
 
+TEST(MotionModel, PredictionAndJacobianTogetherAreTheTwoApartToTheBit) {
+  Vector6d x;
+  x << 3.0, -2.0, 0.7, 0.05, 8.0, 0.3;
+  Matrix6d A;
+  const Vector6d next = predictState(x, 0.02, A);
+  EXPECT_EQ(next, predictState(x, 0.02));
+  EXPECT_EQ(A, motionJacobian(x, 0.02));
+}
+
+TEST(MotionModel, PropagatedCovarianceIsTheDenseProductForTheMotionJacobian) {
+  // A covariance with every entry non-zero, so that a skipped term would show.
+  Eigen::Matrix<double, 6, 6> G;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) G(i, j) = std::sin(1.0 + 7 * i + 3 * j);
+  const Matrix6d P = G * G.transpose() + Matrix6d::Identity();
+  const Matrix6d Q = processNoise({0.005, 10.0, 5.0}, 0.02);
+  for (const double yaw : {0.0, 0.7, -2.5, M_PI}) {
+    Vector6d x;
+    x << 3.0, -2.0, yaw, 0.05, 8.0, 0.3;
+    const Matrix6d A = motionJacobian(x, 0.02);
+    const Matrix6d dense = A * P * A.transpose() + Q;
+    const Matrix6d structured = propagateCovariance(A, P, Q);
+    EXPECT_LT((structured - 0.5 * (dense + dense.transpose())).cwiseAbs().maxCoeff(), 1e-13 * P.cwiseAbs().maxCoeff()) << "yaw " << yaw;
+    EXPECT_EQ(structured, structured.transpose());
+  }
+}
+
 TEST(MotionModel, ProcessNoiseIsAutowaresDiagonal) {
   const Matrix6d Q = processNoise({0.005, 10.0, 5.0}, 0.02);
   Vector6d expected;
