@@ -99,20 +99,36 @@ void ReplayResult::writeInputErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   // Beside each input's error, the standard deviation it claimed along and across the road: where a
-  // source said it did not know (NDT on a featureless stretch) and where it was wrong while sure.
-  out << "stamp_s,source,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg,sd_along_m,sd_across_m\n";
+  // source said it did not know (NDT on a featureless stretch) and where it was wrong while sure. Then
+  // the filter at the same stamp: its output as given out then, and its settled estimate once the input
+  // was in, so that where and why the filter trails an input can be read stretch by stretch (the
+  // summary's where_accurate gives only their means).
+  out << "stamp_s,source,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg,sd_along_m,sd_across_m,"
+         "output_error_m,settled_error_m,settled_along_m,settled_across_m\n";
   const auto claimed = claimedCovariances();
-  char line[400];
-  for (const auto& [source, samples] : input_errors)
+  const auto byStamp = [](const std::map<std::string, std::vector<ErrorSample>>& all, const std::string& source) {
+    std::map<Stamp, const ErrorSample*> index;
+    if (const auto it = all.find(source); it != all.end())
+      for (const ErrorSample& s : it->second) index.emplace(s.stamp, &s);
+    return index;
+  };
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  char line[480];
+  for (const auto& [source, samples] : input_errors) {
+    const auto output = byStamp(fused_at_inputs, source), settled = byStamp(settled_at_inputs, source);
     for (const ErrorSample& s : samples) {
       const auto c = claimed.find({source, s.stamp});
-      const Eigen::Vector2d sd = c == claimed.end() ? Eigen::Vector2d::Constant(std::nan("")) : alongAcrossDeviation(c->second, s.truth_heading);
-      const double sd_along = sd[0], sd_across = sd[1];
-      std::snprintf(line, sizeof line, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(), source.c_str(),
-                    s.estimate.x(), s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI, sd_along,
-                    sd_across);
+      const Eigen::Vector2d sd = c == claimed.end() ? Eigen::Vector2d::Constant(kNone) : alongAcrossDeviation(c->second, s.truth_heading);
+      const auto o = output.find(s.stamp);
+      const auto k = settled.find(s.stamp);
+      const ErrorSample* at = k == settled.end() ? nullptr : k->second;
+      std::snprintf(line, sizeof line, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", formatSeconds(s.stamp).c_str(),
+                    source.c_str(), s.estimate.x(), s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across,
+                    s.heading_error * 180.0 / M_PI, sd[0], sd[1], o == output.end() ? kNone : o->second->error, at ? at->error : kNone,
+                    at ? at->along : kNone, at ? at->across : kNone);
       out << line;
     }
+  }
 }
 
 }  // namespace coloc::replay

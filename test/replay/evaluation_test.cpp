@@ -96,7 +96,24 @@ TEST(Evaluation, InputComparisonWithNothingInCommonIsEmpty) {
 namespace coloc::replay {
 namespace {
 
-// The last two columns of input_error.csv: the standard deviation each input claimed along and across
+// input_error.csv as `r` writes it: its header, then each row's cells.
+std::vector<std::vector<std::string>> writtenInputErrorCsv(const ReplayResult& r, std::string& header) {
+  testing::TempDir dir;
+  const std::string path = dir / "input_error.csv";
+  r.writeInputErrorCsv(path);
+  std::ifstream in(path);
+  std::getline(in, header);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// The claim columns of input_error.csv: the standard deviation each input claimed along and across
 // the true heading, beside its error.
 TEST(Evaluation, InputErrorCsvGivesEachInputsClaimedDeviationAlongAndAcrossTheRoad) {
   // Driving north; NDT claims 0.5 m east-west (across) and 2 cm north-south (along), then nothing east-west.
@@ -121,20 +138,9 @@ TEST(Evaluation, InputErrorCsvGivesEachInputsClaimedDeviationAlongAndAcrossTheRo
   r.pose_input_covariances.push_back((Eigen::Matrix2d() << std::numeric_limits<double>::infinity(), 0.0, 0.0, 0.0004).finished());
   r.input_errors["ndt"] = evaluate(r.pose_inputs, truth, fromSeconds(0.05));
   ASSERT_EQ(r.input_errors["ndt"].size(), 2u);
-  testing::TempDir dir;
-  const std::string path = dir / "input_error.csv";
-  r.writeInputErrorCsv(path);
-  std::ifstream in(path);
-  std::string header, line;
-  std::getline(in, header);
+  std::string header;
+  const auto rows = writtenInputErrorCsv(r, header);
   EXPECT_NE(header.find(",sd_along_m,sd_across_m"), std::string::npos) << header;
-  std::vector<std::vector<std::string>> rows;
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
-    rows.push_back(cells);
-  }
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_NEAR(std::stod(rows[0][7]), 0.02, 1e-6);   // along: 2 cm ahead
   EXPECT_NEAR(std::stod(rows[0][8]), -0.01, 1e-6);  // across: 1 cm east is to the right
@@ -142,6 +148,41 @@ TEST(Evaluation, InputErrorCsvGivesEachInputsClaimedDeviationAlongAndAcrossTheRo
   EXPECT_NEAR(std::stod(rows[0][11]), 0.5, 1e-6);
   EXPECT_EQ(rows[1][10], "inf");  // an axis not measured: no claim along or across
   EXPECT_EQ(rows[1][11], "inf");
+}
+
+// After the claims, the filter at each input's stamp: its output as given out then and its settled
+// estimate, with the settled error along and across the road; "nan" where the filter has none.
+TEST(Evaluation, InputErrorCsvPutsTheFiltersOutputAndSettledEstimateBesideEachInput) {
+  std::vector<io::TrajectoryPoint> truth;
+  for (int k = 0; k <= 100; ++k) {
+    io::TrajectoryPoint p;
+    p.stamp = fromSeconds(0.01 * k);
+    p.pose.position = Eigen::Vector3d(0.1 * k, 0.0, 0.0);  // driving east
+    truth.push_back(p);
+  }
+  const auto at = [](double t, double ahead, double left) {
+    io::TrajectoryPoint p;
+    p.stamp = fromSeconds(t);
+    p.pose.position = Eigen::Vector3d(10.0 * t + ahead, left, 0.0);
+    return p;
+  };
+  ReplayResult r;
+  r.pose_inputs = {at(0.3, 0.01, 0.0), at(0.6, 0.0, -0.02)};
+  r.pose_input_sources = {"ndt", "ndt"};
+  r.input_errors["ndt"] = evaluate(r.pose_inputs, truth, fromSeconds(0.05));
+  r.fused_at_inputs["ndt"] = evaluate({at(0.3, 0.03, 0.04)}, truth, fromSeconds(0.05));  // 5 cm off
+  r.settled_at_inputs["ndt"] = evaluate({at(0.3, -0.006, 0.008)}, truth, fromSeconds(0.05));  // 1 cm off
+  std::string header;
+  const auto rows = writtenInputErrorCsv(r, header);
+  EXPECT_NE(header.find(",sd_along_m,sd_across_m,output_error_m,settled_error_m,settled_along_m,settled_across_m"), std::string::npos) << header;
+  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows[0].size(), 16u);
+  EXPECT_NEAR(std::stod(rows[0][6]), 0.01, 1e-6);    // the input's own error
+  EXPECT_NEAR(std::stod(rows[0][12]), 0.05, 1e-6);   // the output then
+  EXPECT_NEAR(std::stod(rows[0][13]), 0.01, 1e-6);   // settled
+  EXPECT_NEAR(std::stod(rows[0][14]), -0.006, 1e-6);  // 6 mm behind
+  EXPECT_NEAR(std::stod(rows[0][15]), 0.008, 1e-6);   // 8 mm to the left
+  for (int column = 12; column < 16; ++column) EXPECT_EQ(rows[1][column], "nan") << column;  // the filter had none at 0.6 s
 }
 
 }  // namespace
