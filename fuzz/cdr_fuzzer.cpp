@@ -5,7 +5,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  const auto kind = static_cast<coloc::io::MessageKind>(data[0] % 7);
+  const auto kind = static_cast<coloc::io::MessageKind>(data[0] % coloc::io::kMessageKindCount);
   try {
     coloc::io::decodeMessage(kind, data + 1, size - 1);
   } catch (const coloc::Error&) {

@@ -137,6 +137,10 @@ void cdrSeeds(const fs::path& recording) {
     std::memcpy(cloud.data.data() + 4 * i, &v, 4);
   }
   seed("cdr_fuzzer", "cloud", coloc::io::encodePointCloud2(cloud), static_cast<int>(MessageKind::kPointCloud2));
+  coloc::io::TFMessage tf;
+  tf.transforms.push_back({{pose.header.stamp, "base_link"}, "velodyne", {0.9, 0.0, 1.8}, Eigen::Quaterniond(0.9998, 0.0, 0.0, 0.02)});
+  tf.transforms.push_back({{pose.header.stamp, "base_footprint"}, "base_link", {0.0, 0.0, 0.1}, Eigen::Quaterniond::Identity()});
+  seed("cdr_fuzzer", "tf_static", coloc::io::encodeTFMessage(tf), static_cast<int>(MessageKind::kTFMessage));
 }
 
 // Small PCDs of each data kind; binary_compressed is written with LZF literal runs only, which every

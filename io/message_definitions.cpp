@@ -55,6 +55,11 @@ const std::map<std::string, MsgSpec>& specs() {
        {"std_msgs/Header header\nuint32 height\nuint32 width\nPointField[] fields\nbool is_bigendian\n"
         "uint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n",
         {"std_msgs/Header", "sensor_msgs/PointField"}}},
+      {"geometry_msgs/Transform",
+       {"Vector3 translation\nQuaternion rotation\n", {"geometry_msgs/Vector3", "geometry_msgs/Quaternion"}}},
+      {"geometry_msgs/TransformStamped",
+       {"std_msgs/Header header\nstring child_frame_id\nTransform transform\n", {"std_msgs/Header", "geometry_msgs/Transform"}}},
+      {"tf2_msgs/TFMessage", {"geometry_msgs/TransformStamped[] transforms\n", {"geometry_msgs/TransformStamped"}}},
   };
   return table;
 }

@@ -11,6 +11,7 @@
 #include "PointCloud2.h"
 #include "PoseStamped.h"
 #include "PoseWithCovarianceStamped.h"
+#include "TFMessage.h"
 #include "TwistStamped.h"
 #include "TwistWithCovarianceStamped.h"
 #include "cdr_codec.hpp"
@@ -30,8 +31,9 @@ constexpr std::string_view kTwistStampedType = "geometry_msgs/msg/TwistStamped";
 constexpr std::string_view kOdometryType = "nav_msgs/msg/Odometry";
 constexpr std::string_view kImuType = "sensor_msgs/msg/Imu";
 constexpr std::string_view kPointCloud2Type = "sensor_msgs/msg/PointCloud2";
+constexpr std::string_view kTFMessageType = "tf2_msgs/msg/TFMessage";
 
-constexpr std::array<std::pair<MessageKind, std::string_view>, 7> kKinds{{
+constexpr std::array<std::pair<MessageKind, std::string_view>, kMessageKindCount> kKinds{{
     {MessageKind::kPoseWithCovarianceStamped, kPoseWithCovarianceStampedType},
     {MessageKind::kPoseStamped, kPoseStampedType},
     {MessageKind::kTwistWithCovarianceStamped, kTwistWithCovarianceStampedType},
@@ -39,6 +41,7 @@ constexpr std::array<std::pair<MessageKind, std::string_view>, 7> kKinds{{
     {MessageKind::kOdometry, kOdometryType},
     {MessageKind::kImu, kImuType},
     {MessageKind::kPointCloud2, kPointCloud2Type},
+    {MessageKind::kTFMessage, kTFMessageType},
 }};
 
 // ---- layout walks (field names as a user would look them up in the .msg files) ----
@@ -107,6 +110,19 @@ void checkPointCloud2(CdrChecker& c) {
   const std::uint32_t data_size = c.sequenceLength(1, "data");
   c.primitives(1, data_size, "data");
   c.boolean("is_dense");
+}
+
+void checkTFMessage(CdrChecker& c) {
+  // Smallest TransformStamped: stamp, two empty strings (length + NUL), 7 doubles, without padding.
+  const std::uint32_t count = c.sequenceLength(8 + 5 + 5 + 7 * 8, "transforms");
+  for (std::uint32_t i = 0; i < count; ++i) {
+    c.primitive(4, "transforms[].header.stamp.sec");
+    const std::uint32_t nanosec = c.uint32("transforms[].header.stamp.nanosec");
+    if (nanosec >= kNanosPerSecond) throw CdrFormatError("transforms[].header.stamp.nanosec " + std::to_string(nanosec) + " is not below 1e9");
+    c.string("transforms[].header.frame_id");
+    c.string("transforms[].child_frame_id");
+    c.primitives(8, 7, "transforms[].transform");
+  }
 }
 
 // ---- generated types -> coloc ----
@@ -348,6 +364,21 @@ PointCloud2 decodePointCloud2(const std::uint8_t* data, std::size_t size) {
   return out;
 }
 
+TFMessage decodeTFMessage(const std::uint8_t* data, std::size_t size) {
+  const auto msg = detail::deserializeCdr<tf2_msgs::msg::TFMessage>(data, size, kTFMessageType, checkTFMessage);
+  TFMessage out;
+  out.transforms.reserve(msg.transforms().size());
+  for (const auto& t : msg.transforms()) {
+    TransformStamped transform;
+    transform.header = fromRos(t.header());
+    transform.child_frame_id = t.child_frame_id();
+    transform.translation = fromRos(t.transform().translation());
+    transform.rotation = fromRos(t.transform().rotation());
+    out.transforms.push_back(std::move(transform));
+  }
+  return out;
+}
+
 RosMessage decodeMessage(MessageKind kind, const std::uint8_t* data, std::size_t size) {
   switch (kind) {
     case MessageKind::kPoseWithCovarianceStamped: return decodePoseWithCovarianceStamped(data, size);
@@ -357,6 +388,7 @@ RosMessage decodeMessage(MessageKind kind, const std::uint8_t* data, std::size_t
     case MessageKind::kOdometry: return decodeOdometry(data, size);
     case MessageKind::kImu: return decodeImu(data, size);
     case MessageKind::kPointCloud2: return decodePointCloud2(data, size);
+    case MessageKind::kTFMessage: return decodeTFMessage(data, size);
   }
   throw Error("decodeMessage: invalid MessageKind " + std::to_string(static_cast<int>(kind)));
 }
@@ -435,6 +467,21 @@ Bytes encodePointCloud2(const PointCloud2& message) {
   msg.data(message.data);
   msg.is_dense(message.is_dense);
   return detail::serializeCdr(msg, kPointCloud2Type);
+}
+
+Bytes encodeTFMessage(const TFMessage& message) {
+  tf2_msgs::msg::TFMessage msg;
+  checkedSize(message.transforms, "transforms", kTFMessageType);
+  for (const TransformStamped& t : message.transforms) {
+    geometry_msgs::msg::TransformStamped out;
+    out.header(toRos(t.header, kTFMessageType));
+    checkEncodableString(t.child_frame_id, "transforms[].child_frame_id", kTFMessageType);
+    out.child_frame_id(t.child_frame_id);
+    out.transform().translation(toRosVector(t.translation));
+    out.transform().rotation(toRos(t.rotation));
+    msg.transforms().push_back(std::move(out));
+  }
+  return detail::serializeCdr(msg, kTFMessageType);
 }
 
 // ---- rosgraph_msgs/Clock: two 32-bit fields, written by hand ----

@@ -24,6 +24,7 @@ const char* toString(InputRole role) {
     case InputRole::kGroundTruth: return "ground_truth";
     case InputRole::kScan: return "scan";
     case InputRole::kRsuFix: return "rsu_fix";
+    case InputRole::kStaticTransforms: return "tf_static";
     case InputRole::kIgnore: return "ignore";
   }
   return "?";
@@ -130,8 +131,9 @@ InputConfig readInput(const YamlReader& r, const std::string& topic, const YAML:
     const std::string key = r.key(entry.first);
     const std::string full = where + "." + key;
     if (key == "role") {
-      const std::string role = r.choice(entry.second, full, {"pose", "twist", "ground_truth", "scan", "rsu_fix", "ignore"});
-      for (InputRole candidate : {InputRole::kPose, InputRole::kTwist, InputRole::kGroundTruth, InputRole::kScan, InputRole::kRsuFix, InputRole::kIgnore})
+      const std::string role = r.choice(entry.second, full, {"pose", "twist", "ground_truth", "scan", "rsu_fix", "tf_static", "ignore"});
+      for (InputRole candidate : {InputRole::kPose, InputRole::kTwist, InputRole::kGroundTruth, InputRole::kScan, InputRole::kRsuFix,
+                                  InputRole::kStaticTransforms, InputRole::kIgnore})
         if (role == toString(candidate)) input.role = candidate;
       has_role = true;
     } else if (key == "source") {
@@ -144,7 +146,7 @@ InputConfig readInput(const YamlReader& r, const std::string& topic, const YAML:
       input.link = readLink(r, entry.second, full);
     }
   }
-  if (!has_role) r.fail(node, where, "needs a role: pose, twist, ground_truth, scan, rsu_fix or ignore");
+  if (!has_role) r.fail(node, where, "needs a role: pose, twist, ground_truth, scan, rsu_fix, tf_static or ignore");
   if (input.source.empty()) input.source = topic;
   return input;
 }
@@ -219,10 +221,20 @@ const std::vector<Key>& keys() {
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.voxel_size = r.number(n, k); }},
       {"ndt", "max_points", "", "at most this many scan points reach NDT (a repeatable random subset); 0 = all", [](const C& c) { return show(c.ndt.source.preprocess.max_points); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.max_points = static_cast<std::size_t>(r.integer(n, k, 0, 1LL << 40)); }},
-      {"ndt", "lidar_pose", "m, rad", "the LiDAR on the vehicle: x, y, z, roll, pitch, yaw", [](const C& c) { return yamlList(c.ndt.source.lidar_pose); },
+      {"ndt", "lidar_pose", "m, rad",
+       "the LiDAR on the vehicle: x, y, z, roll, pitch, yaw; null = from a replayed log's /tf_static (base_frame to the scans' frame) when it has them, else the vehicle's origin",
+       [](const C& c) { return c.ndt.lidar_pose_given ? yamlList(c.ndt.source.lidar_pose) : S("null"); },
        [](const R& r, const N& n, const S& k, C& c) {
+         c.ndt.lidar_pose_given = !n.IsNull();
+         if (n.IsNull()) return void(c.ndt.source.lidar_pose = Vector6d::Zero());
          const auto v = r.numbers(n, k, 6, "6 numbers [x, y, z, roll, pitch, yaw]");
          c.ndt.source.lidar_pose = Eigen::Map<const Vector6d>(v.data()); }},
+      {"ndt", "base_frame", "", "the vehicle's frame in a log's /tf_static: the LiDAR's pose is looked up from it (ndt.lidar_pose null)",
+       [](const C& c) { return quoted(c.ndt.base_frame); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         const S frame = r.text(n, k);
+         if (frame.empty()) r.fail(n, k, "must name a frame");
+         c.ndt.base_frame = frame; }},
       {"ndt", "map_tile_size", "m", "a single-file map is cut into squares of this size", [](const C& c) { return show(c.ndt.map_tile_size); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.map_tile_size = r.positive(n, k); }},
       {"ndt", "map_radius", "m", "map tiles within this of the vehicle make the NDT target", [](const C& c) { return show(c.ndt.source.map.radius); },
@@ -466,6 +478,7 @@ std::string configYaml(const Config& config, const std::string& heading) {
       out << "\n# How log topics feed the filter. Topics not listed here are chosen by message type:\n"
              "# PoseWithCovarianceStamped -> pose (rsu_fix on /rsu/<id>/fix when rsu.registry is set);\n"
              "# TwistWithCovarianceStamped, Odometry, Imu -> twist; PointCloud2 -> scan (with --map);\n"
+             "# TFMessage on /tf_static -> tf_static (places the LiDAR when ndt.lidar_pose is null);\n"
              "# Odometry or poses on a topic whose name contains \"ground_truth\" -> ground truth; others are listed and skipped.\n"
              "# Example:\n"
              "#   /amcl_pose: {role: pose, source: amcl}\n"

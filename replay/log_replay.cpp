@@ -12,6 +12,7 @@
 #include "coloc/io/bag_reader.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
+#include "coloc/pipeline/static_transforms.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 
 namespace coloc::replay {
@@ -43,18 +44,20 @@ class MessageSource {
     if (bag_) return bag_->next(message_) ? &message_ : nullptr;
     return next_ < log_->messages().size() ? &log_->messages()[next_++] : nullptr;
   }
-  /// Message m as a point cloud (PointCloud2 as `kind`) into `e`: shared from the log in memory, or decoded.
-  void scan(const io::BagMessage& m, io::MessageKind kind, Event& e) const {
+  /// Message m as a point cloud (PointCloud2 as `kind`) into `e`: shared from the log in memory, or
+  /// decoded. Returns the scan's frame.
+  std::string scan(const io::BagMessage& m, io::MessageKind kind, Event& e) const {
     if (log_) {
       RecordedLog::Scan shared = log_->scan(m.index, kind);
       e.stamp = shared.stamp;
       e.input = std::move(shared.cloud);
-      return;
+      return shared.frame_id;
     }
-    const io::RosMessage decoded = io::decodeMessage(kind, m.data);
-    const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
+    io::RosMessage decoded = io::decodeMessage(kind, m.data);
+    io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
     e.stamp = cloud.header.stamp;
     e.input = pipeline::toPointCloud(cloud);
+    return std::move(cloud.header.frame_id);
   }
 
  private:
@@ -70,8 +73,9 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Stage 2: every message of a used topic, decoded; ground truth goes straight into the result.
-std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& config, ReplayResult& result,
+// Stage 2: every message of a used topic, decoded; ground truth goes straight into the result, static
+// transforms into `frames`.
+std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& config, ReplayResult& result, pipeline::StaticTransforms& frames,
                              const std::function<void(double)>& progress) {
   std::map<std::string, std::size_t> topic_index;
   for (std::size_t i = 0; i < result.topics.size(); ++i) topic_index[result.topics[i].topic] = i;
@@ -92,14 +96,27 @@ std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& conf
     ++use.messages;
     if (use.role == InputRole::kIgnore) continue;
     const InputConfig* input = use.from_config ? &config.inputs.at(use.topic) : nullptr;
+    const auto countError = [&](const std::string& what) {
+      if (use.decode_errors++ == 0) use.first_error = "topic " + use.topic + " message #" + std::to_string(message.index) + ": " + what;
+    };
     try {
       Event e{message.log_time, 0, 0, message.index, ti, PoseMeasurement{}};
       if (use.role == InputRole::kScan) {
-        source.scan(message, *use.kind, e);
+        std::string frame = source.scan(message, *use.kind, e);
+        if (use.frame_id.empty()) use.frame_id = std::move(frame);
         events.push_back(std::move(e));
         continue;
       }
       const io::RosMessage decoded = io::decodeMessage(*use.kind, message.data);
+      if (use.role == InputRole::kStaticTransforms) {
+        // Each transform on its own: one that cannot be in the tree is counted, the others are kept.
+        for (const io::TransformStamped& t : std::get<io::TFMessage>(decoded).transforms) try {
+            frames.add(t);
+          } catch (const Error& err) {
+            countError(err.what());
+          }
+        continue;
+      }
       bool fallback = false;
       switch (use.role) {
         case InputRole::kGroundTruth: {
@@ -130,8 +147,7 @@ std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& conf
           e.input);
       events.push_back(std::move(e));
     } catch (const Error& err) {
-      if (use.decode_errors++ == 0)
-        use.first_error = "topic " + use.topic + " message #" + std::to_string(message.index) + ": " + err.what();
+      countError(err.what());
     }
   }
   result.log_duration = toSeconds(last_log - first_log);
@@ -191,9 +207,35 @@ void measureDelays(const std::vector<Event>& events, ReplayResult& result) {
   }
 }
 
+// Where NDT takes the LiDAR to be on the vehicle: as configured, else where the log's /tf_static puts
+// the scans' frame in the base frame, else at the vehicle's origin; the result says which, and why.
+pipeline::Config placeLidar(const pipeline::Config& config, const pipeline::StaticTransforms& frames, ReplayResult& result) {
+  pipeline::Config placed = config;
+  const auto scans = std::find_if(result.topics.begin(), result.topics.end(), [](const TopicUse& t) { return t.role == InputRole::kScan; });
+  if (scans == result.topics.end()) return placed;
+  const bool have_tf = std::any_of(result.topics.begin(), result.topics.end(), [](const TopicUse& t) { return t.role == InputRole::kStaticTransforms; });
+  result.lidar_pose = config.ndt.source.lidar_pose;
+  const std::string& base = config.ndt.base_frame;
+  const std::string& frame = scans->frame_id;
+  if (config.ndt.lidar_pose_given) {
+    result.lidar_pose_from = "ndt.lidar_pose (configured)";
+  } else if (!have_tf) {
+    result.lidar_pose_from = "the vehicle's origin: the log has no /tf_static and ndt.lidar_pose is not given";
+  } else if (frame.empty()) {
+    result.lidar_pose_from = "the vehicle's origin: the scans name no frame to look up in /tf_static";
+  } else if (const auto pose = frames.lookup(base, frame)) {
+    placed.ndt.source.lidar_pose = result.lidar_pose = pipeline::poseVector(*pose);
+    result.lidar_pose_from = "/tf_static: " + frame + " in " + base;
+  } else {
+    result.lidar_pose_from = "the vehicle's origin: /tf_static (" + std::to_string(frames.size()) + " transforms) does not connect '" + base +
+                             "' (ndt.base_frame) to the scans' frame '" + frame + "'; set ndt.base_frame or ndt.lidar_pose";
+  }
+  return placed;
+}
+
 // Stage 5: the inputs through the vehicle pipeline in arrival order, its clock driven by log time.
-void drive(std::vector<Event>& events, const ReplayOptions& options, std::optional<rsu_client::RsuRegistry> registry,
-           ReplayResult& result) {
+void drive(std::vector<Event>& events, const pipeline::Config& config, const ReplayOptions& options,
+           std::optional<rsu_client::RsuRegistry> registry, ReplayResult& result) {
   pipeline::PipelineOptions po;
   po.registry = std::move(registry);
   bool scans = false;
@@ -202,12 +244,11 @@ void drive(std::vector<Event>& events, const ReplayOptions& options, std::option
   // it checks its path; without scans it is not opened, its tiles are not read).
   if (!scans && !options.map.empty()) ndt::TileMap::checkPath(options.map);
   if (scans && !options.map.empty()) {
-    po.map = options.cache ? options.cache->map(options.map, options.config.ndt.map_tile_size)
-                           : ndt::TileMap::open(options.map, options.config.ndt.map_tile_size);
+    po.map = options.cache ? options.cache->map(options.map, config.ndt.map_tile_size) : ndt::TileMap::open(options.map, config.ndt.map_tile_size);
     if (options.cache) po.targets = options.cache->targets();
     if (options.cache) po.alignments = options.cache->alignments();
   }
-  pipeline::Pipeline pipe(options.config, std::move(po));
+  pipeline::Pipeline pipe(config, std::move(po));
   std::vector<fusion::SourceId> source_of(result.topics.size(), -1);
   for (std::size_t i = 0; i < result.topics.size(); ++i) {
     if (result.topics[i].role == InputRole::kPose) source_of[i] = pipe.addPoseSource(result.topics[i].source);
@@ -291,7 +332,8 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
                 describeTopics(listed));
   }
   MessageSource source = recorded ? MessageSource(*recorded) : MessageSource(*bag);
-  std::vector<Event> events = decodeAll(source, config, result, options.progress);
+  pipeline::StaticTransforms frames;
+  std::vector<Event> events = decodeAll(source, config, result, frames, options.progress);
   placeOnStampClock(events, config, result);
   emulateLinks(events, config, result);
   measureDelays(events, result);
@@ -303,7 +345,7 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
     result.inputs_after_until = static_cast<std::uint64_t>(events.end() - later);
     events.erase(later, events.end());
   }
-  drive(events, options, std::move(registry), result);
+  drive(events, placeLidar(config, frames, result), options, std::move(registry), result);
   if (result.fused.empty()) {
     const std::string ended = result.inputs_after_until ? "; the replay ended at stamp " + formatSeconds(options.until) + " (until), before " +
                                                               std::to_string(result.inputs_after_until) + " of its inputs"

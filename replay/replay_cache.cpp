@@ -65,6 +65,7 @@ RecordedLog::Scan RecordedLog::scan(std::size_t i, io::MessageKind kind) const {
       const io::RosMessage decoded = io::decodeMessage(kind, messages_[i].data);
       const io::PointCloud2& cloud = std::get<io::PointCloud2>(decoded);
       slot.scan.stamp = cloud.header.stamp;
+      slot.scan.frame_id = cloud.header.frame_id;
       slot.scan.cloud = std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud));
     } catch (const Error& e) {
       slot.error = e.what();

@@ -70,6 +70,7 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
     j["odometry_speed_scale"] = {{"scale", speed_scale}, {"compared_m", speed_scale_distance}};
     j["odometry_yaw_rate_bias"] = {{"bias_rad_s", yaw_rate_bias}, {"compared_s", yaw_rate_bias_time}};
     j["lidar_mount_yaw"] = {{"yaw_rad", mount_yaw}, {"compared_m", mount_yaw_distance}};
+    j["lidar_pose"] = {{"xyz_rpy", std::vector<double>(lidar_pose.data(), lidar_pose.data() + 6)}, {"from", lidar_pose_from}};
   }
   if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes));
   j["rejections_first"] = rejections;

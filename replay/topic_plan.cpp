@@ -24,6 +24,8 @@ bool canServe(InputRole role, MessageKind kind) {
     case InputRole::kTwist:
       return kind == MessageKind::kTwistWithCovarianceStamped || kind == MessageKind::kTwistStamped || kind == MessageKind::kOdometry ||
              kind == MessageKind::kImu;
+    case InputRole::kStaticTransforms:
+      return kind == MessageKind::kTFMessage;
     case InputRole::kIgnore:
       return true;
   }
@@ -50,6 +52,10 @@ InputRole defaultRole(const std::string& topic, MessageKind kind, bool have_map,
     case MessageKind::kPointCloud2:
       if (have_map) return InputRole::kScan;
       note = "point clouds feed NDT, which needs a map (--map)";
+      return InputRole::kIgnore;
+    case MessageKind::kTFMessage:
+      if (topic == "/tf_static") return InputRole::kStaticTransforms;
+      note = "moving frames are not used; the LiDAR's mounting is read from /tf_static";
       return InputRole::kIgnore;
   }
   return InputRole::kIgnore;

@@ -32,7 +32,7 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
   for (const TopicUse& t : r.topics) {
     std::printf("  %-22s %-44s %-13s %9llu", t.topic.c_str(), t.type.c_str(), toString(t.role),
                 static_cast<unsigned long long>(t.messages));
-    if (t.role != InputRole::kIgnore) std::printf(" %9.1f ms", 1e3 * t.delay_median);
+    if (t.role != InputRole::kIgnore && t.role != InputRole::kStaticTransforms) std::printf(" %9.1f ms", 1e3 * t.delay_median);
     if (!t.note.empty()) std::printf("  (%s)", t.note.c_str());
     if (t.decode_errors) std::printf("  %llu undecodable", static_cast<unsigned long long>(t.decode_errors));
     if (t.fallback_covariance) std::printf("  %llu without covariance: fallback used", static_cast<unsigned long long>(t.fallback_covariance));
@@ -63,6 +63,9 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 (unsigned long long)n.max_iterations, (unsigned long long)n.oscillation, (unsigned long long)n.empty_scan,
                 (unsigned long long)n.no_map, (unsigned long long)r.scans_without_guess, n.scans ? n.align_ms_total / n.scans : 0.0,
                 r.map.builds);
+    const Vector6d& l = r.lidar_pose;
+    std::printf("  LiDAR on the vehicle: [%.3f, %.3f, %.3f] m, roll %.2f, pitch %.2f, yaw %.2f deg, from %s\n", l[0], l[1], l[2], l[3] * 180.0 / M_PI,
+                l[4] * 180.0 / M_PI, l[5] * 180.0 / M_PI, r.lidar_pose_from.c_str());
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
     std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
     std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);

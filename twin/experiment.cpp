@@ -527,6 +527,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     fuse.pipeline.initial_pose = Eigen::Vector4d(scenario.route_start.x(), scenario.route_start.y(), 0.0, scenario.route_heading);
     fuse.ndt.source.lidar_pose = Vector6d::Zero();
     fuse.ndt.source.lidar_pose[2] = scenario.vehicle_lidar_height;
+    fuse.ndt.lidar_pose_given = true;
     std::vector<Eigen::Vector2d> rsu_positions;
     for (const sim::ScenarioRsu& r : scenario.rsus) rsu_positions.push_back(r.position);
     // The drive's replays read its log once, and each NDT target of the site is built once (the same

@@ -36,13 +36,16 @@ std::vector<Sample> samples() {
   cloud.point_step = 5;
   cloud.row_step = 10;
   cloud.data.assign(10, 0xAB);
+  TFMessage tf;
+  tf.transforms.push_back({{fromRosTime(15, 16), "base_link"}, "lidar", {1.0, 0.0, 1.8}, Eigen::Quaterniond::Identity()});
   return {{MessageKind::kPoseWithCovarianceStamped, encodePoseWithCovarianceStamped(pose)},
           {MessageKind::kPoseStamped, encodePoseStamped(pose)},
           {MessageKind::kTwistWithCovarianceStamped, encodeTwistWithCovarianceStamped(twist)},
           {MessageKind::kTwistStamped, encodeTwistStamped(twist)},
           {MessageKind::kOdometry, encodeOdometry(odometry)},
           {MessageKind::kImu, encodeImu(imu)},
-          {MessageKind::kPointCloud2, encodePointCloud2(cloud)}};
+          {MessageKind::kPointCloud2, encodePointCloud2(cloud)},
+          {MessageKind::kTFMessage, encodeTFMessage(tf)}};
 }
 
 std::string decodeError(MessageKind kind, const Bytes& bytes) {
@@ -98,6 +101,13 @@ TEST(CdrRobustness, HugeFieldCountIsRejected) {
   putU32(bytes, 4 + 28, 0x7FFFFFFFu);  // fields count after sec, nanosec, frame (20), height, width
   const std::string message = decodeError(MessageKind::kPointCloud2, bytes);
   EXPECT_NE(message.find("fields: sequence length 2147483647"), std::string::npos) << message;
+}
+
+TEST(CdrRobustness, HugeTransformCountIsRejected) {
+  Bytes bytes = samples()[7].bytes;  // TFMessage with one transform
+  putU32(bytes, 4, 0x7FFFFFFFu);     // the transforms count opens the body
+  const std::string message = decodeError(MessageKind::kTFMessage, bytes);
+  EXPECT_NE(message.find("tf2_msgs/msg/TFMessage: transforms: sequence length 2147483647"), std::string::npos) << message;
 }
 
 TEST(CdrRobustness, HugeStringLengthIsRejected) {

@@ -123,16 +123,16 @@ TEST(McapWriter, KnownTypesGetColocsSchemaAndMessagesKeepTheirBytes) {
 
 TEST(McapWriter, ATypeColocCannotDefineGetsAnEmptySchemaEncodingAsRosbag2Writes) {
   ScratchDir dir;
-  const std::string path = dir / "tf.mcap";
+  const std::string path = dir / "image.mcap";
   {
     McapWriter writer = McapWriter::create(path);
-    writer.addTopic({"/tf", "tf2_msgs/msg/TFMessage", "cdr", "", "", "", 0, {}});
+    writer.addTopic({"/camera", "sensor_msgs/msg/Image", "cdr", "", "", "", 0, {}});
     writer.close();
   }
   BagReader reader = BagReader::open(path);
   ASSERT_EQ(reader.topics().size(), 1u);
-  EXPECT_EQ(reader.topics()[0].type, "tf2_msgs/msg/TFMessage");
-  // "ros2msg" with no text would say the type has no fields: readers would decode every /tf to {}.
+  EXPECT_EQ(reader.topics()[0].type, "sensor_msgs/msg/Image");
+  // "ros2msg" with no text would say the type has no fields: readers would decode every image to {}.
   EXPECT_EQ(reader.topics()[0].message_definition_encoding, "");
   EXPECT_EQ(reader.topics()[0].message_definition, "");
 }

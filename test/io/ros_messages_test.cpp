@@ -234,6 +234,23 @@ TEST(RosMessages, DecodesBigEndianMessages) {
   EXPECT_EQ(out.measurement.pose.orientation.w(), 0.8);
 }
 
+// A transform chain as a static broadcaster sends it: frames, translation and the rotation as sent.
+TEST(RosMessages, TFMessageRoundTripsEveryTransformInOrder) {
+  TFMessage in;
+  in.transforms.push_back({{fromRosTime(100, 5), "base_link"}, "sensor_kit", {0.9, -0.1, 2.0}, Eigen::Quaterniond(0.9999, 0.01, 0.0, 0.005)});
+  in.transforms.push_back({{fromRosTime(100, 5), "sensor_kit"}, "velodyne_top", {0.0, 0.0, 0.1}, Eigen::Quaterniond(0.0, 0.0, 0.0, 1.0)});
+  const TFMessage out = decodeTFMessage(encodeTFMessage(in));
+  ASSERT_EQ(out.transforms.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(out.transforms[i].header.stamp, in.transforms[i].header.stamp);
+    EXPECT_EQ(out.transforms[i].header.frame_id, in.transforms[i].header.frame_id);
+    EXPECT_EQ(out.transforms[i].child_frame_id, in.transforms[i].child_frame_id);
+    EXPECT_EQ(out.transforms[i].translation, in.transforms[i].translation);
+    EXPECT_EQ(out.transforms[i].rotation.coeffs(), in.transforms[i].rotation.coeffs());  // not normalised
+  }
+  EXPECT_TRUE(decodeTFMessage(encodeTFMessage(TFMessage{})).transforms.empty());
+}
+
 TEST(RosMessages, DecodeMessageDispatchesOnKind) {
   const RosMessage message = decodeMessage(MessageKind::kOdometry, encodeOdometry(sampleOdometry()));
   ASSERT_TRUE(std::holds_alternative<Odometry>(message));
@@ -244,10 +261,11 @@ TEST(RosMessages, TypeNamesMapToKindsAndUnknownTypesToNothing) {
   EXPECT_EQ(messageKindOf("geometry_msgs/msg/PoseWithCovarianceStamped"), MessageKind::kPoseWithCovarianceStamped);
   EXPECT_EQ(messageKindOf("nav_msgs/msg/Odometry"), MessageKind::kOdometry);
   EXPECT_EQ(messageKindOf("sensor_msgs/msg/PointCloud2"), MessageKind::kPointCloud2);
-  EXPECT_FALSE(messageKindOf("tf2_msgs/msg/TFMessage").has_value());
+  EXPECT_EQ(messageKindOf("tf2_msgs/msg/TFMessage"), MessageKind::kTFMessage);
+  EXPECT_FALSE(messageKindOf("sensor_msgs/msg/Image").has_value());
   EXPECT_FALSE(messageKindOf("geometry_msgs/PoseStamped").has_value());  // ROS 1 spelling
   for (const auto name : supportedRosTypes()) EXPECT_EQ(rosTypeName(*messageKindOf(name)), name);
-  EXPECT_EQ(supportedRosTypes().size(), 7u);
+  EXPECT_EQ(supportedRosTypes().size(), static_cast<std::size_t>(kMessageKindCount));
 }
 
 TEST(RosMessages, MessageDefinitionsListDependenciesOnce) {
@@ -262,7 +280,8 @@ TEST(RosMessages, MessageDefinitionsListDependenciesOnce) {
   }
   EXPECT_NE(text.find(std::string(80, '=') + "\nMSG: "), std::string::npos);
   EXPECT_NE(rosMessageDefinition("sensor_msgs/msg/PointCloud2").find("uint8 FLOAT32=7"), std::string::npos);
-  EXPECT_EQ(rosMessageDefinition("tf2_msgs/msg/TFMessage"), "");
+  EXPECT_EQ(rosMessageDefinition("sensor_msgs/msg/Image"), "");
+  EXPECT_EQ(rosMessageDefinition("tf2_msgs/msg/TFMessage").rfind("geometry_msgs/TransformStamped[] transforms\n", 0), 0u);
 }
 
 TEST(RosMessages, EncodingRejectsStampsOutsideRosTime) {

@@ -72,6 +72,9 @@ TEST(Config, ReadsTheNdtSection) {
   EXPECT_EQ(c.ndt.source.preprocess.max_points, 2000u);
   EXPECT_EQ(c.ndt.source.ndt.covariance, ndt::CovarianceMode::kLaplace);
   EXPECT_EQ(c.ndt.source.lidar_pose[2], 1.8);
+  EXPECT_TRUE(c.ndt.lidar_pose_given);
+  EXPECT_FALSE(parseConfig("ndt:\n  lidar_pose: null\n", "test.yaml").ndt.lidar_pose_given);
+  EXPECT_FALSE(Config().ndt.lidar_pose_given);  // by default a log's /tf_static places the LiDAR
 }
 
 TEST(Config, UnknownKeysAreErrorsNamingKeyAndLine) {
@@ -86,11 +89,12 @@ TEST(Config, WrongTypesAndRangesAreErrorsNamingTheKey) {
   expectError("fusion:\n  history_steps: 2.5\n", "fusion.history_steps: expected an integer");
   expectError("fusion:\n  predict_frequency: -1\n", "predict_frequency");
   expectError("fusion:\n  pose_gate_alpha: .nan\n", "must not be NaN");
-  expectError("inputs:\n  /odom: {role: velocity}\n", "inputs./odom.role: expected one of pose, twist, ground_truth, scan, rsu_fix, ignore");
+  expectError("inputs:\n  /odom: {role: velocity}\n", "inputs./odom.role: expected one of pose, twist, ground_truth, scan, rsu_fix, tf_static, ignore");
   expectError("inputs:\n  /odom: {source: x}\n", "needs a role");
   expectError("ndt:\n  backend: gpu\n", "ndt.backend: expected one of pcl, fast, got 'gpu'");
   expectError("ndt:\n  resolution: 0\n", "ndt.resolution: must be a finite number > 0");
   expectError("ndt:\n  lidar_pose: [0, 0, 1]\n", "ndt.lidar_pose: expected 6 numbers");
+  expectError("ndt:\n  base_frame: \"\"\n", "ndt.base_frame: must name a frame");
   expectError("ndt:\n  voxel_sise: 1.0\n", "ndt.voxel_sise: unknown key");
   expectError("pipeline:\n  initial_pose: [1, 2]\n", "pipeline.initial_pose: expected [x, y, z, yaw]");
   expectError("inputs:\n  /odom: {role: twist, covariance_diagonal: [1, 2]}\n", "expected 6 variances");
@@ -139,6 +143,8 @@ TEST(Config, AnyConfigurationWrittenOutReadsBackToTheBit) {
   c.ndt.source.ndt.fixed_covariance << 0.000776543210987, 0.000776543210987, 0.0225, 0.000625, 0.000625, kInfinity;
   c.ndt.source.ndt.score_temperature = 1.0 / 3.0;
   c.ndt.source.lidar_pose << 0.0, 0.0, 1.9, 0.0, 0.0, 0.0;
+  c.ndt.lidar_pose_given = true;
+  c.ndt.base_frame = "base_footprint";
   c.pipeline.initial_pose = Eigen::Vector4d(0.1, -1.75, 0.0, 0.1234567890123);
   InputConfig fix;
   fix.role = InputRole::kRsuFix;
@@ -163,6 +169,9 @@ TEST(Config, AnyConfigurationWrittenOutReadsBackToTheBit) {
   EXPECT_EQ(back.ndt.source.ndt.score_temperature, 1.0 / 3.0);
   EXPECT_EQ(back.ndt.source.ndt.covariance, ndt::CovarianceMode::kMultiNdtScore);
   EXPECT_EQ(*back.pipeline.initial_pose, *c.pipeline.initial_pose);
+  EXPECT_TRUE(back.ndt.lidar_pose_given);
+  EXPECT_EQ(back.ndt.source.lidar_pose, c.ndt.source.lidar_pose);
+  EXPECT_EQ(back.ndt.base_frame, "base_footprint");
   ASSERT_EQ(back.inputs.size(), 2u);
   const InputConfig& f = back.inputs.at("/rsu/rsu_a/fix");
   EXPECT_EQ(f.role, InputRole::kRsuFix);

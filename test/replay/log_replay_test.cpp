@@ -13,6 +13,7 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
+#include "coloc/pipeline/static_transforms.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "real_data.hpp"
 #include "temp_dir.hpp"
@@ -46,7 +47,11 @@ TEST(LogReplay, RealNav2RecordingIsFusedFromAmclPosesAndOdometryTwist) {
   EXPECT_EQ(topic(r, "/amcl_pose").role, InputRole::kPose);
   EXPECT_EQ(topic(r, "/odom").role, InputRole::kTwist);
   EXPECT_EQ(topic(r, "/tf").role, InputRole::kIgnore);
-  EXPECT_EQ(topic(r, "/tf").note, "type not decoded by coloc");
+  EXPECT_EQ(topic(r, "/tf").note, "moving frames are not used; the LiDAR's mounting is read from /tf_static");
+  EXPECT_EQ(topic(r, "/tf_static").role, InputRole::kStaticTransforms);  // the real recording's transforms decode
+  EXPECT_EQ(topic(r, "/tf_static").messages, 1u);
+  EXPECT_EQ(topic(r, "/tf_static").decode_errors, 0u) << topic(r, "/tf_static").first_error;
+  EXPECT_TRUE(r.lidar_pose_from.empty());  // no scans: no LiDAR to place
   EXPECT_EQ(topic(r, "/odom").fallback_covariance, 2639u);  // the TurtleBot's odometry carries no covariance
   // Header stamps are simulation time, log times wall clock: the replay must relate them, not mix them.
   EXPECT_EQ(r.clock, ClockMode::kSeparate);
@@ -283,6 +288,107 @@ TEST(LogReplay, ScansInTheLogAreMatchedAgainstTheMapAndFused) {
   EXPECT_NEAR(r.pose_inputs.back().pose.position.x(), gt1(0, 3), 0.03);
   EXPECT_NEAR(r.pose_inputs.back().pose.position.y(), gt1(1, 3), 0.03);
   EXPECT_GE(counters(r, "ndt").applied, 3u);
+}
+
+// The real pair's source scan as a LiDAR mounted at `mount` on the vehicle records it (points in the
+// LiDAR's frame "velodyne_top"), with the log's /tf_static placing that frame through a sensor kit, and
+// `extra` transforms after them.
+void writeMountedScanLog(const std::string& path, const Eigen::Isometry3d& mount, const std::vector<io::TransformStamped>& extra = {}) {
+  const ndt::PointCloud scan = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
+  ndt::PointCloud in_lidar;
+  for (const auto& p : scan.points) in_lidar.points.push_back((mount.inverse() * p.cast<double>()).cast<float>());
+  const Stamp t0 = 1'700'000'000'000'000'000LL;
+  // base_link -> sensor_kit (0.5 m up, 0.1 rad of yaw) -> velodyne_top (the rest of the mount).
+  Eigen::Isometry3d kit = Eigen::Isometry3d::Identity();
+  kit.translation() = Eigen::Vector3d(0.0, 0.0, 0.5);
+  kit.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Isometry3d rest = kit.inverse() * mount;
+  io::TFMessage tf;
+  tf.transforms.push_back({{t0, "base_link"}, "sensor_kit", kit.translation(), Eigen::Quaterniond(kit.linear())});
+  tf.transforms.push_back({{t0, "sensor_kit"}, "velodyne_top", rest.translation(), Eigen::Quaterniond(rest.linear())});
+  tf.transforms.insert(tf.transforms.end(), extra.begin(), extra.end());
+  io::BagWriter bag = io::BagWriter::create(path);
+  bag.addTopic(topicOf("/tf_static", "tf2_msgs/msg/TFMessage"));
+  bag.addTopic(topicOf("/points", "sensor_msgs/msg/PointCloud2"));
+  const io::Bytes tf_bytes = io::encodeTFMessage(tf);
+  bag.write("/tf_static", t0, tf_bytes.data(), tf_bytes.size());
+  for (int i = 0; i < 3; ++i) {
+    io::PointCloud2 m = toMessage(in_lidar, t0 + i * 100'000'000LL);
+    m.header.frame_id = "velodyne_top";
+    const io::Bytes b = io::encodePointCloud2(m);
+    bag.write("/points", t0 + i * 100'000'000LL + 30'000'000LL, b.data(), b.size());
+  }
+  bag.close();
+}
+
+Eigen::Isometry3d testMount() {
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.translation() = Eigen::Vector3d(1.2, -0.3, 1.8);
+  mount.linear() = quaternionFromRollPitchYaw(0.01, -0.02, 0.25).toRotationMatrix();
+  return mount;
+}
+
+ReplayResult replayAgainstThePairsMap(const std::string& log, const std::string& extra_config = "") {
+  ReplayOptions options;
+  options.map = testing::realData("hdl32e_pair/target.pcd");
+  options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n" + extra_config, "test.yaml");
+  return replayLog(log, options);
+}
+
+TEST(LogReplay, ALogsTfStaticPlacesTheLidarWhereTheConfigDoesNot) {
+  testing::TempDir dir;
+  writeScanLog(dir / "plain", 3);
+  writeMountedScanLog(dir / "mounted", testMount());
+  const ReplayResult plain = replayAgainstThePairsMap(dir / "plain");
+  const ReplayResult mounted = replayAgainstThePairsMap(dir / "mounted");
+  EXPECT_EQ(topic(mounted, "/tf_static").role, InputRole::kStaticTransforms);
+  EXPECT_EQ(topic(mounted, "/points").frame_id, "velodyne_top");
+  EXPECT_EQ(mounted.lidar_pose_from, "/tf_static: velodyne_top in base_link");
+  const Vector6d expected = pipeline::poseVector(testMount());
+  EXPECT_LT((mounted.lidar_pose - expected).norm(), 1e-9);
+  // Matched as the scan taken at the vehicle's origin is: both within 3 cm of the pair's reference (the
+  // range crop and the voxel grid work in the LiDAR's frame, so the points NDT gets differ a little).
+  const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
+  ASSERT_EQ(mounted.ndt.poses, 3u);
+  for (const ReplayResult* r : {&plain, &mounted}) {
+    ASSERT_FALSE(r->pose_inputs.empty());
+    EXPECT_LT((r->pose_inputs.back().pose.position.head<2>() - gt1.block<2, 1>(0, 3)).norm(), 0.03);
+  }
+  // Taken at the origin instead, the same scans are 1.2 m off: NDT does not find the reference.
+  const ReplayResult at_origin = replayAgainstThePairsMap(dir / "mounted", "  base_frame: base_footprint\n");
+  EXPECT_TRUE(at_origin.pose_inputs.empty() || (at_origin.pose_inputs.back().pose.position.head<2>() - gt1.block<2, 1>(0, 3)).norm() > 0.3);
+  EXPECT_NE(mounted.summaryJson("log").find("\"from\": \"/tf_static: velodyne_top in base_link\""), std::string::npos);
+}
+
+TEST(LogReplay, AConfiguredLidarPoseWinsAndAnUnconnectedBaseFrameLeavesTheLidarAtTheOriginSayingWhy) {
+  testing::TempDir dir;
+  writeMountedScanLog(dir / "mounted", testMount());
+  const Vector6d m = pipeline::poseVector(testMount());
+  char configured[200];
+  std::snprintf(configured, sizeof configured, "  lidar_pose: [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]\n", m[0], m[1], m[2], m[3], m[4], m[5]);
+  const ReplayResult given = replayAgainstThePairsMap(dir / "mounted", configured);
+  EXPECT_EQ(given.lidar_pose_from, "ndt.lidar_pose (configured)");
+  EXPECT_EQ(given.lidar_pose, m);
+  const ReplayResult unconnected = replayAgainstThePairsMap(dir / "mounted", "  base_frame: base_footprint\n");
+  EXPECT_EQ(unconnected.lidar_pose, Vector6d::Zero());
+  EXPECT_NE(unconnected.lidar_pose_from.find("does not connect 'base_footprint' (ndt.base_frame) to the scans' frame 'velodyne_top'"),
+            std::string::npos)
+      << unconnected.lidar_pose_from;
+}
+
+TEST(LogReplay, ABadTransformInTfStaticIsCountedNamingItsFramesAndTheOthersAreKept) {
+  testing::TempDir dir;
+  io::TransformStamped bad;
+  bad.header.frame_id = "base_link";
+  bad.child_frame_id = "camera";
+  bad.rotation = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.0);
+  writeMountedScanLog(dir / "mounted", testMount(), {bad});
+  const ReplayResult r = replayAgainstThePairsMap(dir / "mounted");
+  EXPECT_EQ(topic(r, "/tf_static").decode_errors, 1u);
+  EXPECT_NE(topic(r, "/tf_static").first_error.find("static transform 'base_link' -> 'camera': rotation is not a unit quaternion"),
+            std::string::npos)
+      << topic(r, "/tf_static").first_error;
+  EXPECT_EQ(r.lidar_pose_from, "/tf_static: velodyne_top in base_link");
 }
 
 TEST(LogReplay, ReplaysSharingACacheGiveTheSameResultsAsReplaysApart) {

@@ -86,6 +86,20 @@ struct PointCloud2 {
   bool is_dense = false;
 };
 
+/// geometry_msgs/msg/TransformStamped: where child_frame_id's origin and axes are in header.frame_id
+/// (a point p in the child frame is rotation * p + translation in the parent frame).
+struct TransformStamped {
+  Header header;
+  std::string child_frame_id;
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  ///< as sent: not normalised
+};
+
+/// tf2_msgs/msg/TFMessage, what /tf and /tf_static carry.
+struct TFMessage {
+  std::vector<TransformStamped> transforms;
+};
+
 /// The message types coloc decodes, one per ROS type name.
 enum class MessageKind : std::uint8_t {
   kPoseWithCovarianceStamped,
@@ -95,7 +109,9 @@ enum class MessageKind : std::uint8_t {
   kOdometry,
   kImu,
   kPointCloud2,
+  kTFMessage,
 };
+inline constexpr int kMessageKindCount = 8;
 
 /// "geometry_msgs/msg/PoseWithCovarianceStamped" -> kPoseWithCovarianceStamped; nullopt for types coloc
 /// does not decode (callers list those to the user instead of failing).
@@ -116,6 +132,7 @@ StampedTwist decodeTwistStamped(const std::uint8_t* data, std::size_t size);
 Odometry decodeOdometry(const std::uint8_t* data, std::size_t size);
 Imu decodeImu(const std::uint8_t* data, std::size_t size);
 PointCloud2 decodePointCloud2(const std::uint8_t* data, std::size_t size);
+TFMessage decodeTFMessage(const std::uint8_t* data, std::size_t size);
 
 inline StampedPose decodePoseWithCovarianceStamped(const Bytes& b) {
   return decodePoseWithCovarianceStamped(b.data(), b.size());
@@ -128,9 +145,10 @@ inline StampedTwist decodeTwistStamped(const Bytes& b) { return decodeTwistStamp
 inline Odometry decodeOdometry(const Bytes& b) { return decodeOdometry(b.data(), b.size()); }
 inline Imu decodeImu(const Bytes& b) { return decodeImu(b.data(), b.size()); }
 inline PointCloud2 decodePointCloud2(const Bytes& b) { return decodePointCloud2(b.data(), b.size()); }
+inline TFMessage decodeTFMessage(const Bytes& b) { return decodeTFMessage(b.data(), b.size()); }
 
 /// Any decodable message; the alternative follows the kind (both pose kinds give StampedPose, ...).
-using RosMessage = std::variant<StampedPose, StampedTwist, Odometry, Imu, PointCloud2>;
+using RosMessage = std::variant<StampedPose, StampedTwist, Odometry, Imu, PointCloud2, TFMessage>;
 RosMessage decodeMessage(MessageKind kind, const std::uint8_t* data, std::size_t size);
 inline RosMessage decodeMessage(MessageKind kind, const Bytes& b) { return decodeMessage(kind, b.data(), b.size()); }
 
@@ -144,6 +162,7 @@ Bytes encodeTwistStamped(const StampedTwist& message);
 Bytes encodeOdometry(const Odometry& message);
 Bytes encodeImu(const Imu& message);
 Bytes encodePointCloud2(const PointCloud2& message);
+Bytes encodeTFMessage(const TFMessage& message);
 
 /// rosgraph_msgs/msg/Clock, what a player of recorded logs publishes on /clock so that nodes run on the
 /// log's time (ROS 2's use_sim_time). Its one field, builtin_interfaces/Time, as a stamp.

@@ -17,7 +17,9 @@
 
 namespace coloc::pipeline {
 
-enum class InputRole { kPose, kTwist, kGroundTruth, kScan, kRsuFix, kIgnore };
+/// kStaticTransforms: a tf2_msgs/TFMessage topic whose transforms place the LiDAR on the vehicle
+/// (a log's /tf_static), read when ndt.lidar_pose is not given.
+enum class InputRole { kPose, kTwist, kGroundTruth, kScan, kRsuFix, kStaticTransforms, kIgnore };
 const char* toString(InputRole role);
 
 /// How one topic is used. Topics not listed are chosen by message type (see README).
@@ -58,6 +60,11 @@ struct ReplayConfig {
 struct NdtSection {
   ndt::NdtPoseSourceConfig source;
   double map_tile_size = 20.0;  ///< m; a single-file map is cut into squares of this size
+  /// Whether source.lidar_pose was given (ndt.lidar_pose). Not given, a replayed log's /tf_static
+  /// places the LiDAR (`base_frame` to the scans' frame) when it has the transforms; otherwise, and
+  /// live, the LiDAR is at the vehicle's origin.
+  bool lidar_pose_given = false;
+  std::string base_frame = "base_link";  ///< the vehicle's frame in /tf_static, whose pose the filter estimates
 };
 
 /// Roadside fixes: which RSUs are trusted and how fresh a fix must be.

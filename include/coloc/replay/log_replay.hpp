@@ -54,6 +54,10 @@ struct ReplayResult {
   double wall_seconds = 0.0;                       ///< replay time, decoding included
   std::uint64_t messages_read = 0;
   std::uint64_t inputs_after_until = 0;            ///< inputs not given to the filter: ReplayOptions::until
+  /// Where NDT took the LiDAR to be on the vehicle (x, y, z, roll, pitch, yaw), and from what: the
+  /// config's ndt.lidar_pose, the log's /tf_static, or the vehicle's origin and why (empty without scans).
+  Vector6d lidar_pose = Vector6d::Zero();
+  std::string lidar_pose_from;
   /// The log's files that were never closed, read up to their cut (ReplayOptions::recover).
   std::vector<io::RecoveredFile> recovered;
   std::vector<std::string> rejections;             ///< the first few rejection messages, for the summary

@@ -29,6 +29,7 @@ class RecordedLog {
   struct Scan {
     Stamp stamp = 0;
     std::shared_ptr<const ndt::PointCloud> cloud;
+    std::string frame_id;  ///< the message's header.frame_id (empty for a scan given decoded)
   };
   /// A log made in memory (a simulated drive): `messages` in the order they were written, put in the
   /// order a rosbag2 reader gives them (by log time, then as written) and numbered; each topic's

@@ -1,8 +1,8 @@
 #pragma once
 // Stage 1 of a replay: what each topic of the log is for. The config names a role; otherwise the
 // message type decides (poses are pose sources, twists and odometry twist sources, "ground_truth" in a
-// name marks the truth, point clouds feed NDT when there is a map, and /rsu/<id>/fix topics are
-// roadside fixes when there is an RSU registry).
+// name marks the truth, point clouds feed NDT when there is a map, /rsu/<id>/fix topics are roadside
+// fixes when there is an RSU registry, and /tf_static places the LiDAR on the vehicle).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -23,6 +23,7 @@ struct TopicUse {
   std::optional<io::MessageKind> kind;
   std::string source;       ///< Localizer source name (pose / twist roles)
   std::string rsu_id;       ///< rsu_fix role: whose fixes
+  std::string frame_id;     ///< scan role: the frame of its first scan (where the LiDAR is)
   bool from_config = false; ///< role set in the config rather than chosen by type
   std::string note;         ///< why a topic is skipped, or how its covariance was completed
   std::uint64_t messages = 0;
