@@ -46,13 +46,21 @@ constexpr std::array<std::pair<MessageKind, std::string_view>, kMessageKindCount
 
 // ---- layout walks (field names as a user would look them up in the .msg files) ----
 
-void checkHeader(CdrChecker& c) {
-  c.primitive(4, "header.stamp.sec");
-  const std::uint32_t nanosec = c.uint32("header.stamp.nanosec");
+// A header's field names as errors give them: at the top of a message, or inside a sequence.
+struct HeaderFields {
+  const char* sec;
+  const char* nanosec;
+  const char* frame_id;
+};
+constexpr HeaderFields kHeaderFields{"header.stamp.sec", "header.stamp.nanosec", "header.frame_id"};
+
+void checkHeader(CdrChecker& c, const HeaderFields& f = kHeaderFields) {
+  c.primitive(4, f.sec);
+  const std::uint32_t nanosec = c.uint32(f.nanosec);
   if (nanosec >= kNanosPerSecond) {
-    throw CdrFormatError("header.stamp.nanosec " + std::to_string(nanosec) + " is not below 1e9");
+    throw CdrFormatError(std::string(f.nanosec) + " " + std::to_string(nanosec) + " is not below 1e9");
   }
-  c.string("header.frame_id");
+  c.string(f.frame_id);
 }
 
 void checkPoseWithCovarianceStamped(CdrChecker& c) {
@@ -116,10 +124,7 @@ void checkTFMessage(CdrChecker& c) {
   // Smallest TransformStamped: stamp, two empty strings (length + NUL), 7 doubles, without padding.
   const std::uint32_t count = c.sequenceLength(8 + 5 + 5 + 7 * 8, "transforms");
   for (std::uint32_t i = 0; i < count; ++i) {
-    c.primitive(4, "transforms[].header.stamp.sec");
-    const std::uint32_t nanosec = c.uint32("transforms[].header.stamp.nanosec");
-    if (nanosec >= kNanosPerSecond) throw CdrFormatError("transforms[].header.stamp.nanosec " + std::to_string(nanosec) + " is not below 1e9");
-    c.string("transforms[].header.frame_id");
+    checkHeader(c, {"transforms[].header.stamp.sec", "transforms[].header.stamp.nanosec", "transforms[].header.frame_id"});
     c.string("transforms[].child_frame_id");
     c.primitives(8, 7, "transforms[].transform");
   }

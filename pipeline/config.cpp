@@ -226,7 +226,10 @@ const std::vector<Key>& keys() {
        [](const C& c) { return c.ndt.lidar_pose_given ? yamlList(c.ndt.source.lidar_pose) : S("null"); },
        [](const R& r, const N& n, const S& k, C& c) {
          c.ndt.lidar_pose_given = !n.IsNull();
-         if (n.IsNull()) return void(c.ndt.source.lidar_pose = Vector6d::Zero());
+         if (n.IsNull()) {
+           c.ndt.source.lidar_pose = Vector6d::Zero();
+           return;
+         }
          const auto v = r.numbers(n, k, 6, "6 numbers [x, y, z, roll, pitch, yaw]");
          c.ndt.source.lidar_pose = Eigen::Map<const Vector6d>(v.data()); }},
       {"ndt", "base_frame", "", "the vehicle's frame in a log's /tf_static: the LiDAR's pose is looked up from it (ndt.lidar_pose null)",

@@ -110,11 +110,13 @@ std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& conf
       const io::RosMessage decoded = io::decodeMessage(*use.kind, message.data);
       if (use.role == InputRole::kStaticTransforms) {
         // Each transform on its own: one that cannot be in the tree is counted, the others are kept.
-        for (const io::TransformStamped& t : std::get<io::TFMessage>(decoded).transforms) try {
+        for (const io::TransformStamped& t : std::get<io::TFMessage>(decoded).transforms) {
+          try {
             frames.add(t);
           } catch (const Error& err) {
             countError(err.what());
           }
+        }
         continue;
       }
       bool fallback = false;

@@ -32,8 +32,8 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
   for (const TopicUse& t : topics) {
     nlohmann::ordered_json o = {{"topic", t.topic}, {"type", t.type}, {"role", toString(t.role)}, {"messages", t.messages}};
     if (t.role == InputRole::kPose || t.role == InputRole::kTwist || t.role == InputRole::kRsuFix) o["source"] = t.source;
-    if (t.role != InputRole::kIgnore) {
-      o["decode_errors"] = t.decode_errors;
+    if (t.role != InputRole::kIgnore) o["decode_errors"] = t.decode_errors;
+    if (t.role != InputRole::kIgnore && t.role != InputRole::kStaticTransforms) {  // inputs the filter takes
       o["fallback_covariance"] = t.fallback_covariance;
       o["link_dropped"] = t.link_dropped;
       o["delay_median_s"] = t.delay_median;
