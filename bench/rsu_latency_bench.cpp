@@ -92,7 +92,7 @@ int main() {
   const pipeline::PipelineReport report = vehicle.report();
   std::lock_guard<std::mutex> lock(mutex);
   std::printf("fixes: %d published, %zu queued, %llu accepted by the checks, %zu handed to the filter\n", kFixes, queued.size(),
-              static_cast<unsigned long long>(report.fixes.count("rsu_a") ? report.fixes.at("rsu_a").accepted : 0), total.size());
+              static_cast<unsigned long long>(report.fixes.count("rsu_a") ? report.fixes.at("rsu_a").passed_checks : 0), total.size());
   for (const std::string& r : rejections) std::printf("  %s\n", r.c_str());
   std::printf("%-52s %10s %10s\n", "path", "median us", "p99 us");
   std::printf("%-52s %10.1f %10.1f\n", "publish -> in the filter (whole path)", percentileUs(total, 0.5), percentileUs(total, 0.99));

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 
 #include "coloc/core/error.hpp"
 #include "coloc/core/chi_square.hpp"
+#include "integrity_monitor.hpp"
 #include "measurement_record.hpp"
 #include "state_history.hpp"
 
@@ -31,12 +33,17 @@ void validate(const EkfConfig& c) {
   requireConfig(c.pose_gate_alpha >= 0.0 && c.pose_gate_alpha < 1.0, "pose_gate_alpha", "must be in [0, 1)");
   requireConfig(c.pose_gate_recovery >= 0, "pose_gate_recovery", "must be >= 0");
   requireConfig(c.twist_gate_alpha >= 0.0 && c.twist_gate_alpha < 1.0, "twist_gate_alpha", "must be in [0, 1)");
+  requireConfig(c.integrity_lost_after_gated_anchors >= 0, "integrity_lost_after_gated_anchors", "must be >= 0");
+  requireConfig(c.integrity_degraded_after_gated >= 0, "integrity_degraded_after_gated", "must be >= 0");
   const std::pair<const char*, double> non_negative[] = {
       {"proc_stddev_yaw_c", c.proc_stddev_yaw_c},       {"proc_stddev_vx_c", c.proc_stddev_vx_c},
       {"proc_stddev_wz_c", c.proc_stddev_wz_c},         {"z_filter_proc_dev", c.z_filter_proc_dev},
       {"roll_filter_proc_dev", c.roll_filter_proc_dev}, {"pitch_filter_proc_dev", c.pitch_filter_proc_dev},
       {"threshold_observable_velocity_mps", c.threshold_observable_velocity_mps},
-      {"future_tolerance", c.future_tolerance},         {"initial_yaw_bias_variance", c.initial_yaw_bias_variance}};
+      {"future_tolerance", c.future_tolerance},         {"initial_yaw_bias_variance", c.initial_yaw_bias_variance},
+      {"integrity_anchor_agreement", c.integrity_anchor_agreement},
+      {"integrity_dead_reckoning_limit", c.integrity_dead_reckoning_limit},
+      {"integrity_anchor_memory", c.integrity_anchor_memory}};
   for (const auto& [key, value] : non_negative) requireConfig(std::isfinite(value) && value >= 0.0, key, "must be finite and >= 0");
   requireConfig(std::isfinite(c.initial_vx_variance) && c.initial_vx_variance > 0.0, "initial_vx_variance", "must be finite and > 0");
   requireConfig(std::isfinite(c.initial_wz_variance) && c.initial_wz_variance > 0.0, "initial_wz_variance", "must be finite and > 0");
@@ -67,6 +74,7 @@ struct Localizer::Impl {
     SourceCounters counters;
     int gated_in_a_row = 0;
     int smoothing_steps = 0;  ///< 0: the configuration's for the kind
+    bool anchor = false;      ///< independent of the vehicle's map matching (see integrity.hpp)
   };
   // A measurement still being applied over its smoothing steps.
   struct Active {
@@ -96,15 +104,17 @@ struct Localizer::Impl {
   std::vector<Pending> pending;
   std::uint64_t unknown_sources = 0;
   std::function<void(const Verdict&)> listener;
+  IntegrityMonitor integrity;
 
   explicit Impl(const EkfConfig& c)
       : config((validate(c), c)),
         history(historyOptions(c)),
         pose_gate(gateThresholds(c.pose_gate_alpha)),
         twist_gate(gateThresholds(c.twist_gate_alpha)),
-        future_tolerance(fromSeconds(c.future_tolerance)) {}
+        future_tolerance(fromSeconds(c.future_tolerance)),
+        integrity(c) {}
 
-  SourceId add(const std::string& name, SourceKind kind, int smoothing_steps = 0) {
+  SourceId add(const std::string& name, SourceKind kind, int smoothing_steps = 0, bool anchor = false) {
     if (smoothing_steps < 0) throw Error("source '" + name + "': smoothing_steps must be >= 1 (0: the configuration's), got " + std::to_string(smoothing_steps));
     if (auto it = by_name.find(name); it != by_name.end()) {
       if (sources[it->second].kind != kind)
@@ -114,6 +124,7 @@ struct Localizer::Impl {
     }
     sources.push_back({name, kind, {}});
     sources.back().smoothing_steps = smoothing_steps;
+    sources.back().anchor = anchor;
     by_name.emplace(name, static_cast<SourceId>(sources.size() - 1));
     return static_cast<SourceId>(sources.size() - 1);
   }
@@ -187,6 +198,7 @@ struct Localizer::Impl {
                            src.gated_in_a_row >= config.pose_gate_recovery && std::isfinite(d2);
       if (!recover) {
         ++src.gated_in_a_row;
+        if (src.kind == SourceKind::kPose) integrity.onPose(src.name, src.anchor, false, planarInnovation(back, record), d2, clock);
         Verdict v{Outcome::kRejected, Reason::kGated, inputKind(id), src.name, stamp, back, d2, why.str()};
         ++src.counters.gated;
         return report(std::move(v));
@@ -202,6 +214,8 @@ struct Localizer::Impl {
     } else {
       src.gated_in_a_row = 0;
     }
+    if (src.kind == SourceKind::kPose)
+      integrity.onPose(src.name, src.anchor, true, src.anchor ? planarInnovation(back, record) : Eigen::Vector2d::Zero(), d2, clock);
     const int steps = smoothingSteps(src);
     // The tick must stay in the history for all uses; fewer, heavier uses carry the same information.
     const int uses = std::max(1, std::min(steps, 1 + config.history_steps - back));
@@ -219,6 +233,17 @@ struct Localizer::Impl {
       active.push_back({id, stamp, record, uses - 1, uses});
     }
     return accept(id, stamp, Outcome::kApplied, back, d2, note);
+  }
+
+  // Measured minus predicted x and y at the tick (NaN for a component the record does not measure).
+  Eigen::Vector2d planarInnovation(int back, const UpdateRecord& record) {
+    Eigen::Vector2d out = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    const Innovation in = innovation(history.stateAt(back), record, 1.0);
+    for (int i = 0; i < record.m; ++i) {
+      if (record.index[i] == kX) out.x() = in.e[i];
+      if (record.index[i] == kY) out.y() = in.e[i];
+    }
+    return out;
   }
 
   FilterState initialState(const UpdateRecord& r) const {
@@ -244,6 +269,7 @@ struct Localizer::Impl {
     initialized = true;
     if (!clock_set || clock < stamp) clock = stamp;
     clock_set = true;
+    integrity.restart(stamp, true);
     // Waiting measurements older than the new start can never find their tick.
     std::vector<Pending> waiting;
     waiting.swap(pending);
@@ -342,8 +368,10 @@ struct Localizer::Impl {
     }
     clock = now;
     clock_set = true;
-    if (initialized)
+    if (initialized) {
       while (history.latestStamp() + history.options().step <= now) tick();
+      integrity.onTick(history.latestStamp());
+    }
     return Verdict{Outcome::kApplied, Reason::kNone, InputKind::kClock, "", now, -1, 0.0, {}};
   }
 
@@ -378,6 +406,9 @@ struct Localizer::Impl {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) e.pose_covariance(rows[i], rows[j]) = s.P(states[i], states[j]);
     for (int a = 0; a < 3; ++a) e.pose_covariance(2 + a, 2 + a) = s.aux[a].variance;  // +inf until measured
+    e.localization = integrity.status().state;
+    if (e.localization == LocalizationState::kDegraded || e.localization == LocalizationState::kLost)
+      e.pose_covariance.topLeftCorner<2, 2>() += integrity.inflation();
     e.linear_velocity = {s.x[kVx], 0.0, 0.0};
     e.angular_velocity = {0.0, 0.0, s.x[kWz]};
     for (int i = 1; i < 5; ++i) e.twist_covariance(i, i) = kInfinity;  // vy, vz, wx, wy are not estimated
@@ -393,7 +424,9 @@ Localizer::~Localizer() = default;
 Localizer::Localizer(Localizer&&) noexcept = default;
 Localizer& Localizer::operator=(Localizer&&) noexcept = default;
 
-SourceId Localizer::addPoseSource(const std::string& name, int smoothing_steps) { return impl_->add(name, SourceKind::kPose, smoothing_steps); }
+SourceId Localizer::addPoseSource(const std::string& name, int smoothing_steps, bool anchor) {
+  return impl_->add(name, SourceKind::kPose, smoothing_steps, anchor);
+}
 SourceId Localizer::addTwistSource(const std::string& name) { return impl_->add(name, SourceKind::kTwist); }
 
 std::optional<SourceId> Localizer::findSource(std::string_view name) const {
@@ -417,6 +450,20 @@ Verdict Localizer::initialize(const PoseMeasurement& pose) {
 }
 
 bool Localizer::initialized() const { return impl_->initialized; }
+
+void Localizer::reset() {
+  Impl& d = *impl_;
+  for (const Impl::Pending& p : d.pending) --d.sources[p.source].counters.pending;
+  d.pending.clear();
+  d.active.clear();
+  d.initialized = false;
+  d.clock_set = false;
+  d.clock = 0;
+  for (Impl::Source& s : d.sources) s.gated_in_a_row = 0;
+  d.integrity.restart(0, false);
+}
+
+const IntegrityStatus& Localizer::integrity() const { return impl_->integrity.status(); }
 
 Verdict Localizer::feedPose(SourceId source, const PoseMeasurement& m) {
   return impl_->feed(source, SourceKind::kPose, m.stamp, makePoseRecord(m));

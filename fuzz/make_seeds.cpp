@@ -12,6 +12,7 @@
 
 #include <fastdds/rtps/common/SerializedPayload.h>
 
+#include "OdometryPubSubTypes.h"
 #include "PoseWithCovarianceStampedPubSubTypes.h"
 #include "VehicleDimensionsPubSubTypes.h"
 #include "coloc/core/error.hpp"
@@ -195,11 +196,16 @@ void ddsSeeds() {
   covariance[14] = covariance[21] = covariance[28] = covariance[35] = 1e300;
   fix.pose().covariance(covariance);
   seed("dds_payload_fuzzer", "fix", serialized<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(fix), 0);
+  nav_msgs::msg::Odometry addressed;
+  addressed.header(fix.header());
+  addressed.child_frame_id("7");
+  addressed.pose(fix.pose());
+  seed("dds_payload_fuzzer", "addressed_fix", serialized<nav_msgs::msg::OdometryPubSubType>(addressed), 1);
   coloc_msgs::msg::VehicleDimensions dimensions;
   dimensions.station_id(7);
   dimensions.length(4.8);
   dimensions.width(1.9);
-  seed("dds_payload_fuzzer", "dimensions", serialized<coloc_msgs::msg::VehicleDimensionsPubSubType>(dimensions), 1);
+  seed("dds_payload_fuzzer", "dimensions", serialized<coloc_msgs::msg::VehicleDimensionsPubSubType>(dimensions), 2);
 }
 
 }  // namespace

@@ -112,6 +112,7 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
   po.clock = [&d] { return d.now(); };
   d.pipe = std::make_unique<pipeline::Pipeline>(d.config, std::move(po));
   d.pipe->onEstimate([&d](const fusion::Estimate& e) { d.publish(e); });
+  if (options.on_event) d.pipe->onEvent(options.on_event);
   const fusion::SourceId twist_source = d.pipe->addTwistSource(d.config.live.twist_topic);
 
   d.node = std::make_unique<rsu_client::DdsNode>(options.dds);
@@ -127,10 +128,9 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
     clock_qos.depth = 1;
     d.node->subscribe(io::kClockTopic, io::kClockType, clock_qos, [&d, t](Bytes&& b, Stamp) {
       d.receive(t, b, [&d](const Bytes& bytes, Stamp) {
-        const Stamp time = io::decodeClock(bytes.data(), bytes.size());
-        Stamp previous = d.sim_now.load();
-        while (time > previous && !d.sim_now.compare_exchange_weak(previous, time)) {
-        }
+        // The node's time is the last /clock received, back in time too (a player that loops or
+        // restarts): the pipeline sees the jump and starts the filter again.
+        d.sim_now.store(io::decodeClock(bytes.data(), bytes.size()));
       });
     });
   }
@@ -169,15 +169,19 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
                         });
                       });
   }
-  for (const std::string& id : rsu_ids) {
-    const std::string topic = rsu_client::fixTopic(id);
-    const std::size_t t = d.addTopic(topic, "geometry_msgs/msg/PoseWithCovarianceStamped");
-    d.node->subscribe(topic, "geometry_msgs/msg/PoseWithCovarianceStamped", inputQos(d.config, 5), [&d, t, id](Bytes&& b, Stamp) {
-      d.receive(t, b, [&d, &id](const Bytes& bytes, Stamp arrival) {
-        d.pipe->pushFix(pipeline::fixFromMessage(io::decodePoseWithCovarianceStamped(bytes), id), arrival);
+  // Each RSU's addressed fixes (the protocol) and its unaddressed ones, which the checks refuse unless
+  // rsu.accept_unaddressed: both are subscribed so that what arrives on either is counted.
+  for (const std::string& id : rsu_ids)
+    for (const auto& [topic, type] : {std::make_pair(rsu_client::addressedFixTopic(id), io::MessageKind::kOdometry),
+                                      std::make_pair(rsu_client::fixTopic(id), io::MessageKind::kPoseWithCovarianceStamped)}) {
+      const std::string ros_type = type == io::MessageKind::kOdometry ? "nav_msgs/msg/Odometry" : "geometry_msgs/msg/PoseWithCovarianceStamped";
+      const std::size_t t = d.addTopic(topic, ros_type);
+      d.node->subscribe(topic, ros_type, inputQos(d.config, 5), [&d, t, id, kind = type](Bytes&& b, Stamp) {
+        d.receive(t, b, [&d, &id, kind](const Bytes& bytes, Stamp arrival) {
+          d.pipe->pushFix(pipeline::fixFromMessage(io::decodeMessage(kind, bytes), id), arrival);
+        });
       });
-    });
-  }
+    }
   d.pipe->start();
 }
 
@@ -230,7 +234,8 @@ std::string LiveLocalizer::summaryJson() const {
     j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(s.report.ndt, s.report.map, s.report.scans_without_guess));
     j["ndt"]["scans_superseded"] = s.report.scans_superseded;
   }
-  if (!s.report.fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(s.report.fixes));
+  if (!s.report.fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(s.report.fixes, s.report.filter_of_fixes));
+  j["localization"] = nlohmann::ordered_json::parse(pipeline::localizationJson(s.report));
   j["rejections"] = s.report.rejections;
   j["rejections_first"] = s.report.first_rejections;
   return j.dump(2) + "\n";

@@ -83,13 +83,17 @@ ScanOutcome NdtPoseSource::match(const PointCloud& scan, Stamp stamp, const Pose
     out.detail = std::string(toString(out.alignment.rejection)) + ": " + out.alignment.detail;
     return out;
   }
+  producePose(out, stamp);
+  return out;
+}
+
+void NdtPoseSource::producePose(ScanOutcome& out, Stamp stamp) const {
   const Eigen::Matrix4d base = out.alignment.transform * base_to_lidar_.inverse();
   out.pose.stamp = stamp;
   out.pose.pose.position = base.topRightCorner<3, 1>();
   out.pose.pose.orientation = Eigen::Quaterniond(base.topLeftCorner<3, 3>()).normalized();
   out.pose.covariance = out.alignment.covariance;
   out.produced = true;
-  return out;
 }
 
 void NdtPoseSource::count(const ScanOutcome& out) {

@@ -253,6 +253,14 @@ const std::vector<Key>& keys() {
       {"rsu", "future_tolerance", "s", "fixes stamped further than this after their arrival are refused (from_future)",
        [](const C& c) { return show(c.rsu.checks.future_tolerance); },
        [](const R& r, const N& n, const S& k, C& c) { c.rsu.checks.future_tolerance = r.inRange(n, k, 0.0, 10.0); }},
+      {"rsu", "station_id", "", "this vehicle's station id (its CAM's): only fixes addressed to it are taken; null = none, every addressed fix is another's",
+       [](const C& c) { return c.rsu.checks.station_id ? std::to_string(*c.rsu.checks.station_id) : S("null"); },
+       [](const R& r, const N& n, const S& k, C& c) {
+         if (n.IsNull()) return c.rsu.checks.station_id.reset();
+         c.rsu.checks.station_id = static_cast<std::uint32_t>(r.integer(n, k, 0, 4294967295LL)); }},
+      {"rsu", "accept_unaddressed", "", "take fixes that name no vehicle (/rsu/<id>/fix): only where the RSU sees one connected vehicle",
+       [](const C& c) { return S(c.rsu.checks.accept_unaddressed ? "true" : "false"); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.checks.accept_unaddressed = r.flag(n, k); }},
       {"rsu", "smoothing_steps", "ticks", "each fix is applied over this many ticks, each with covariance x steps; 0 = fusion.pose_smoothing_steps",
        [](const C& c) { return show(c.rsu.smoothing_steps); },
        [](const R& r, const N& n, const S& k, C& c) { c.rsu.smoothing_steps = static_cast<int>(r.integer(n, k, 0, 50)); }},
@@ -479,7 +487,8 @@ std::string configYaml(const Config& config, const std::string& heading) {
     }
     if (std::string(section) == "messages") {
       out << "\n# How log topics feed the filter. Topics not listed here are chosen by message type:\n"
-             "# PoseWithCovarianceStamped -> pose (rsu_fix on /rsu/<id>/fix when rsu.registry is set);\n"
+             "# PoseWithCovarianceStamped -> pose (rsu_fix on /rsu/<id>/fix when rsu.registry is set, as Odometry\n"
+             "# on /rsu/<id>/addressed_fix);\n"
              "# TwistWithCovarianceStamped, Odometry, Imu -> twist; PointCloud2 -> scan (with --map);\n"
              "# TFMessage on /tf_static -> tf_static (places the LiDAR when ndt.lidar_pose is null);\n"
              "# Odometry or poses on a topic whose name contains \"ground_truth\" -> ground truth; others are listed and skipped.\n"

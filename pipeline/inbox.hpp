@@ -27,6 +27,22 @@ class Inbox {
     return std::make_pair(node.key().first, std::move(node.mapped()));
   }
 
+  /// Drops every item that arrived after `now` (on a clock that went back: they belong to the time
+  /// before the jump); returns how many.
+  std::size_t dropArrivedAfter(Stamp now) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::size_t dropped = 0;
+    for (auto it = items_.begin(); it != items_.end();) {
+      if (it->first.first > now) {
+        it = items_.erase(it);
+        ++dropped;
+      } else {
+        ++it;
+      }
+    }
+    return dropped;
+  }
+
   std::size_t size() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return items_.size();

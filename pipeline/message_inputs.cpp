@@ -166,21 +166,42 @@ PoseMeasurement poseFromMessage(const io::RosMessage& message, const InputConfig
   return p;
 }
 
-rsu_client::RsuFix fixFromMessage(const io::StampedPose& message, const std::string& rsu_id) {
+namespace {
+
+rsu_client::RsuFix fixFromPose(const io::Header& header, const PoseMeasurement& pose, const std::string& rsu_id) {
   rsu_client::RsuFix fix;
-  fix.stamp = message.measurement.stamp;
+  fix.stamp = pose.stamp;
   fix.rsu_id = rsu_id;
-  fix.x = message.measurement.pose.position.x();
-  fix.y = message.measurement.pose.position.y();
-  const double yaw_variance = message.measurement.covariance(5, 5);
-  if (std::isfinite(yaw_variance) && yaw_variance > 0.0) fix.yaw = rollPitchYaw(message.measurement.pose.orientation)[2];
+  fix.x = pose.pose.position.x();
+  fix.y = pose.pose.position.y();
+  const double yaw_variance = pose.covariance(5, 5);
+  if (std::isfinite(yaw_variance) && yaw_variance > 0.0) fix.yaw = rollPitchYaw(pose.pose.orientation)[2];
   // The decoder has refused a nanosec field of 1e9 or more already; the stamp's own is what was sent.
   rsu_client::SentFields sent;
-  sent.frame_id = message.header.frame_id;
-  sent.covariance = message.measurement.covariance;
-  sent.nanosec = static_cast<std::uint32_t>(((message.measurement.stamp % kNanosPerSecond) + kNanosPerSecond) % kNanosPerSecond);
+  sent.frame_id = header.frame_id;
+  sent.covariance = pose.covariance;
+  sent.nanosec = static_cast<std::uint32_t>(((pose.stamp % kNanosPerSecond) + kNanosPerSecond) % kNanosPerSecond);
   fix.sent = std::move(sent);
   return fix;
+}
+
+}  // namespace
+
+rsu_client::RsuFix fixFromMessage(const io::StampedPose& message, const std::string& rsu_id) {
+  return fixFromPose(message.header, message.measurement, rsu_id);
+}
+
+rsu_client::RsuFix fixFromMessage(const io::Odometry& message, const std::string& rsu_id) {
+  rsu_client::RsuFix fix = fixFromPose(message.header, message.pose, rsu_id);
+  fix.sent->child_frame_id = message.child_frame_id;
+  fix.station_id = rsu_client::parseStationId(message.child_frame_id);
+  return fix;
+}
+
+rsu_client::RsuFix fixFromMessage(const io::RosMessage& message, const std::string& rsu_id) {
+  if (const auto* odom = std::get_if<io::Odometry>(&message)) return fixFromMessage(*odom, rsu_id);
+  if (const auto* pose = std::get_if<io::StampedPose>(&message)) return fixFromMessage(*pose, rsu_id);
+  throw Error("an RSU fix is a nav_msgs/msg/Odometry (addressed) or a geometry_msgs/msg/PoseWithCovarianceStamped (unaddressed)");
 }
 
 }  // namespace coloc::pipeline

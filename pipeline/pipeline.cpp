@@ -5,12 +5,14 @@
 #include <cmath>
 #include <condition_variable>
 #include <deque>
+#include <set>
 #include <thread>
 #include <variant>
 
 #include "coloc/core/error.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "inbox.hpp"
+#include "initializer.hpp"
 #include "speed_scale.hpp"
 #include "mount_yaw.hpp"
 #include "yaw_rate_bias.hpp"
@@ -68,6 +70,7 @@ PoseMeasurement initialPose(const Eigen::Vector4d& xyz_yaw, Stamp stamp) {
 }
 
 constexpr std::size_t kKeptRejections = 20;
+constexpr std::size_t kKeptEvents = 50;
 
 }  // namespace
 
@@ -75,7 +78,9 @@ constexpr std::size_t kKeptRejections = 20;
 class NdtThread {
  public:
   using Done = std::function<void(ndt::ScanOutcome, Stamp scan_stamp)>;
-  NdtThread(ndt::NdtPoseSource& source, Done done) : source_(source), done_(std::move(done)), thread_([this] { run(); }) {}
+  /// `use`: held while the source matches, so that the pipeline's own use of it (a heading search) waits.
+  NdtThread(ndt::NdtPoseSource& source, std::mutex& use, Done done)
+      : source_(source), use_(use), done_(std::move(done)), thread_([this] { run(); }) {}
   ~NdtThread() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -117,7 +122,11 @@ class NdtThread {
         job = std::move(*job_);
         job_.reset();
       }
-      ndt::ScanOutcome outcome = source_.process(job.cloud, job.stamp, job.guess.pose, job.guess.state[4], job.guess.state[5]);
+      ndt::ScanOutcome outcome;
+      {
+        std::lock_guard<std::mutex> using_source(use_);
+        outcome = source_.process(job.cloud, job.stamp, job.guess.pose, job.guess.state[4], job.guess.state[5]);
+      }
       {
         std::lock_guard<std::mutex> lock(mutex_);
         counters_ = source_.counters();
@@ -127,6 +136,7 @@ class NdtThread {
     }
   }
   ndt::NdtPoseSource& source_;
+  std::mutex& use_;
   Done done_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -147,9 +157,16 @@ struct Pipeline::Impl {
   fusion::Localizer localizer;
   std::vector<std::string> source_names;  // by SourceId
   std::unique_ptr<ndt::NdtPoseSource> ndt;
+  std::mutex ndt_use;  // live: the NDT thread's matching and the pipeline's heading search take turns
   fusion::SourceId ndt_id = -1;
+  std::set<fusion::SourceId> anchors;  // the RSUs' fix sources
+  Initializer initializer;
+  fusion::LocalizationState last_state = fusion::LocalizationState::kInitialising;
   std::optional<rsu_client::FixChecker> checker;
   std::map<std::string, fusion::SourceId> fix_sources;  // by RSU id
+  SpeedScaleConfig speed_scale_config;
+  YawRateBiasConfig yaw_rate_bias_config;
+  MountYawConfig mount_yaw_config;
   SpeedScaleEstimator speed_scale;
   YawRateBiasEstimator yaw_rate_bias;
   MountYawEstimator mount_yaw;
@@ -168,6 +185,7 @@ struct Pipeline::Impl {
   std::deque<Settling> settling;
   std::function<void(const std::string&, const TwistMeasurement&, const TwistMeasurement&)> on_twist_input;
   std::function<void(const std::string&)> on_rejection;
+  std::function<void(const std::string&)> on_event;
 
   mutable std::mutex estimate_mutex;
   std::optional<fusion::Estimate> latest;
@@ -183,9 +201,12 @@ struct Pipeline::Impl {
         step(static_cast<Duration>(std::llround(1e9 / c.fusion.predict_frequency))),
         now(options.clock ? options.clock : std::function<Stamp()>(rsu_client::systemNow)),
         localizer(c.fusion),
-        speed_scale(SpeedScaleConfig{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory}),
-        yaw_rate_bias(YawRateBiasConfig{c.pipeline.yaw_rate_bias_estimation && options.map.has_value(), 2.0, c.pipeline.yaw_rate_bias_memory}),
-        mount_yaw(MountYawConfig{c.pipeline.mount_yaw_estimation && options.map.has_value(), 5.0, c.pipeline.mount_yaw_memory}) {
+        speed_scale_config{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory},
+        yaw_rate_bias_config{c.pipeline.yaw_rate_bias_estimation && options.map.has_value(), 2.0, c.pipeline.yaw_rate_bias_memory},
+        mount_yaw_config{c.pipeline.mount_yaw_estimation && options.map.has_value(), 5.0, c.pipeline.mount_yaw_memory},
+        speed_scale(speed_scale_config),
+        yaw_rate_bias(yaw_rate_bias_config),
+        mount_yaw(mount_yaw_config) {
     const Vector6d& e = c.ndt.source.lidar_pose;
     base_to_lidar = Eigen::Translation3d(e.head<3>()) * Eigen::Quaterniond(quaternionFromRollPitchYaw(e[3], e[4], e[5]));
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
@@ -199,19 +220,19 @@ struct Pipeline::Impl {
       ndt_id = addSource(kNdtSource, fusion::SourceKind::kPose);
       report.ndt_used = true;
       if (options.ndt_thread)
-        ndt_thread = std::make_unique<NdtThread>(*ndt, [this](ndt::ScanOutcome outcome, Stamp stamp) {
+        ndt_thread = std::make_unique<NdtThread>(*ndt, ndt_use, [this](ndt::ScanOutcome outcome, Stamp stamp) {
           inbox.push(NdtResult{std::move(outcome), stamp}, now());
         });
     }
     if (options.registry) {
       checker.emplace(std::move(*options.registry), config.rsu.checks);
       for (const rsu_client::RsuInfo& rsu : checker->registry().rsus())
-        fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose, config.rsu.smoothing_steps);
+        anchors.insert(fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose, config.rsu.smoothing_steps, true));
     }
   }
 
-  fusion::SourceId addSource(const std::string& name, fusion::SourceKind kind, int smoothing_steps = 0) {
-    const fusion::SourceId id = kind == fusion::SourceKind::kPose ? localizer.addPoseSource(name, smoothing_steps) : localizer.addTwistSource(name);
+  fusion::SourceId addSource(const std::string& name, fusion::SourceKind kind, int smoothing_steps = 0, bool anchor = false) {
+    const fusion::SourceId id = kind == fusion::SourceKind::kPose ? localizer.addPoseSource(name, smoothing_steps, anchor) : localizer.addTwistSource(name);
     if (static_cast<std::size_t>(id) >= source_names.size()) source_names.resize(id + 1);
     source_names[id] = name;
     return id;
@@ -221,6 +242,83 @@ struct Pipeline::Impl {
     ++report.rejections;
     if (report.first_rejections.size() < kKeptRejections) report.first_rejections.push_back(line);
     if (on_rejection) on_rejection(line);
+  }
+
+  // Starts, recoveries, state changes and clock resets: said once each, as they happen.
+  void event(const std::string& line) {
+    ++report.events;
+    if (report.first_events.size() < kKeptEvents) report.first_events.push_back(line);
+    if (on_event) on_event(line);
+  }
+
+  void noteState() {
+    const fusion::IntegrityStatus& s = localizer.integrity();
+    report.state = s.state;
+    report.state_reason = s.reason;
+    report.degradations = s.degradations;
+    report.losses = s.losses;
+    if (s.state == last_state) return;
+    last_state = s.state;
+    if (s.state != fusion::LocalizationState::kInitialising)
+      event(formatSeconds(s.since) + " " + toString(s.state) + (s.reason.empty() ? std::string() : ": " + s.reason));
+  }
+
+  // A pose to start from; with `hint` (a lost filter's heading) a recovery.
+  void start(const StartPose& start, const std::string& why) {
+    localizer.initialize(start.pose);
+    if (!localizer.initialized()) return;
+    last_state = fusion::LocalizationState::kLocalized;
+    noteState();
+    report.started_how = start.how;
+    event(formatSeconds(start.pose.stamp) + " " + why + ": " + start.how);
+    emit(*localizer.estimate());
+  }
+
+  void tryStart() {
+    std::lock_guard<std::mutex> using_ndt(ndt_use);
+    std::string waiting;
+    const std::optional<StartPose> found = initializer.tryStart(ndt.get(), std::nullopt, waiting);
+    report.state_reason = waiting;
+    if (!found) return;
+    ++report.starts;
+    start(*found, "started");
+  }
+
+  // A lost filter starts again from the sources that agree: the RSU's position first, the heading
+  // searched by NDT near the filter's own, or the direction of travel.
+  void tryRecover() {
+    const std::string why = localizer.integrity().reason;
+    const double heading = rollPitchYaw(localizer.estimate()->pose.orientation)[2];
+    std::lock_guard<std::mutex> using_ndt(ndt_use);
+    std::string waiting;
+    const std::optional<StartPose> found = initializer.tryStart(ndt.get(), heading, waiting);
+    if (!found) return;
+    ++report.recoveries;
+    if (report.recovery_reasons.size() < kKeptRejections) report.recovery_reasons.push_back(why);
+    start(*found, "recovered (" + why + ")");
+  }
+
+  bool lost() const { return localizer.integrity().state == fusion::LocalizationState::kLost; }
+
+  // The clock went back (a log played again, a player restarted): everything the filter knew belongs
+  // to the other timeline. As a ROS 2 node on a jump back in time, it starts again.
+  void clockWentBack(Stamp now) {
+    const std::size_t dropped = inbox.dropArrivedAfter(now);
+    event(formatSeconds(now) + " clock went back by " + formatSeconds(clock - now) + " s: the filter starts again" +
+          (dropped ? " (" + std::to_string(dropped) + " inputs from before the jump dropped)" : std::string()));
+    ++report.clock_resets;
+    report.inputs_dropped_by_reset += dropped;
+    localizer.reset();
+    initializer.reset();
+    settling.clear();
+    speed_scale = SpeedScaleEstimator(speed_scale_config);
+    yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
+    mount_yaw = MountYawEstimator(mount_yaw_config);
+    if (checker) checker->forgetRecent();
+    first_input_seen = false;
+    last_state = fusion::LocalizationState::kInitialising;
+    noteState();
+    clock = now;
   }
 
   void emit(const fusion::Estimate& e) {
@@ -240,6 +338,7 @@ struct Pipeline::Impl {
       if ((now - latest_tick) / step < 1'000'000) {
         for (Stamp tick = latest_tick + step; tick <= now; tick += step) {
           localizer.advanceTo(tick);
+          if (localizer.integrity().state != last_state) noteState();
           emit(*localizer.estimate());
           settle(tick);
         }
@@ -296,6 +395,17 @@ struct Pipeline::Impl {
         ++report.scans_without_map;
         return reject("scan stamped " + formatSeconds(scan->stamp) + ": no map to match it against");
       }
+      // Kept a short while: a start or a recovery searches NDT's heading on the scan nearest a position.
+      initializer.addScan(scan->cloud, scan->stamp);
+      if (!localizer.initialized()) {
+        tryStart();
+        if (!localizer.initialized()) ++report.scans_without_guess;
+        return;
+      }
+      if (lost()) {
+        tryRecover();
+        if (!lost()) return;
+      }
       // NDT starts from the filter's prediction for the scan's stamp; its pose goes back in stamped
       // with the scan, and the filter compensates the matching time as any delay.
       const std::optional<fusion::Estimate> guess = localizer.estimateAt(scan->stamp);
@@ -314,6 +424,7 @@ struct Pipeline::Impl {
       // A twist that measures speed (odometry, not an IMU) is scaled by what NDT taught about it, and
       // one that measures yaw rate has the bias NDT showed taken out.
       TwistMeasurement t = twist->twist;
+      if (std::isfinite(t.covariance(0, 0)) && std::isfinite(t.linear.x())) initializer.setSpeed(t.linear.x());
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
@@ -325,6 +436,13 @@ struct Pipeline::Impl {
       if (on_twist_input) on_twist_input(source_names[twist->source], t, twist->twist);
       localizer.feedTwist(twist->source, t);
     } else if (auto* pose = std::get_if<PoseInput>(&input)) {
+      // A position without a heading (GNSS) can start the filter as a roadside fix does.
+      const Matrix6d& c = pose->pose.covariance;
+      if (!localizer.initialized() && std::isfinite(c(0, 0)) && std::isfinite(c(1, 1)) && !std::isfinite(c(5, 5)) &&
+          pose->pose.pose.position.head<2>().allFinite() && c(0, 0) > 0.0 && c(1, 1) > 0.0) {
+        initializer.addPosition(source_names[pose->source], pose->pose.stamp, pose->pose.pose.position.head<2>(), std::max(c(0, 0), c(1, 1)));
+        tryStart();
+      }
       feedPose(pose->source, pose->pose);
     } else if (auto* fix = std::get_if<FixInput>(&input)) {
       if (!checker) {
@@ -335,21 +453,41 @@ struct Pipeline::Impl {
       }
       const rsu_client::FixVerdict v = checker->check(fix->fix, arrival);
       if (!v.accepted()) return reject(v.detail);
-      feedPose(fix_sources.at(fix->fix.rsu_id), v.measurement);
+      const fusion::SourceId source = fix_sources.at(fix->fix.rsu_id);
+      initializer.addPosition(source_names[source], v.measurement.stamp, v.measurement.pose.position.head<2>(), v.measurement.covariance(0, 0));
+      if (!localizer.initialized()) tryStart();
+      feedPose(source, v.measurement);
+      if (lost()) tryRecover();
     } else {
-      localizer.initialize(std::get<InitialPoseInput>(input).pose);
-      if (localizer.initialized()) emit(*localizer.estimate());
+      const PoseMeasurement& pose = std::get<InitialPoseInput>(input).pose;
+      localizer.initialize(pose);
+      if (localizer.initialized()) {
+        ++report.starts;
+        report.started_how = "initial pose";
+        last_state = fusion::LocalizationState::kLocalized;
+        noteState();
+        event(formatSeconds(pose.stamp) + " started: initial pose");
+        emit(*localizer.estimate());
+      }
     }
+    if (localizer.integrity().state != last_state) noteState();
   }
 
   void drain(Stamp now) {
     std::lock_guard<std::mutex> lock(state_mutex);
+    if (clock_set && now + step < clock) clockWentBack(now);
     while (auto item = inbox.takeArrivedBy(now)) {
       auto& [arrival, input] = *item;
       if (!first_input_seen) {
         first_input_seen = true;
-        if (config.pipeline.initial_pose && !localizer.initialized())
+        if (config.pipeline.initial_pose && !localizer.initialized()) {
           localizer.initialize(initialPose(*config.pipeline.initial_pose, stampOf(input)));
+          if (localizer.initialized()) {
+            ++report.starts;
+            report.started_how = "pipeline.initial_pose";
+            event(formatSeconds(stampOf(input)) + " started: pipeline.initial_pose");
+          }
+        }
       }
       runTo(arrival);
       apply(input, arrival);
@@ -427,6 +565,10 @@ void Pipeline::onRejection(std::function<void(const std::string&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_rejection = std::move(callback);
 }
+void Pipeline::onEvent(std::function<void(const std::string&)> callback) {
+  std::lock_guard<std::mutex> lock(impl_->state_mutex);
+  impl_->on_event = std::move(callback);
+}
 
 void Pipeline::runUntil(Stamp now) { impl_->drain(now); }
 
@@ -461,6 +603,9 @@ PipelineReport Pipeline::report() const {
   }
   if (impl_->checker)
     for (const auto& [id, c] : impl_->checker->counters()) r.fixes[id] = c;
+  // What the filter made of the fixes that passed the checks.
+  for (const auto& [id, source] : impl_->fix_sources)
+    if (r.fixes.count(id)) r.filter_of_fixes[id] = impl_->localizer.counters(source);
   r.speed_scale = impl_->speed_scale.scale();
   r.speed_scale_distance = impl_->speed_scale.comparedDistance();
   r.yaw_rate_bias = impl_->yaw_rate_bias.bias();

@@ -32,13 +32,39 @@ std::string ndtJson(const ndt::NdtPoseSourceCounters& n, const ndt::DynamicMapSt
   return j.dump();
 }
 
-std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes) {
+std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes, const std::map<std::string, fusion::SourceCounters>& filter) {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
   for (const auto& [id, c] : fixes) {
-    nlohmann::ordered_json o = {{"received", c.received}, {"accepted", c.accepted}};
-    for (const auto& [reason, count] : rsu_client::refusals(c)) o[reason] = count;
+    nlohmann::ordered_json o = {{"received", c.received}, {"passed_checks", c.passed_checks}};
+    nlohmann::ordered_json refused = nlohmann::ordered_json::object();
+    for (const auto& [reason, count] : rsu_client::refusals(c)) refused[reason] = count;
+    o["refused_by_checks"] = std::move(refused);
+    const auto f = filter.find(id);
+    const fusion::SourceCounters none;
+    const fusion::SourceCounters& fc = f == filter.end() ? none : f->second;
+    o["applied"] = fc.applied;
+    o["gated"] = fc.gated;
+    o["not_initialized"] = fc.not_initialized;
+    o["too_old"] = fc.too_old;
+    o["other_filter_refusals"] = fc.from_future + fc.invalid + fc.numerical;
+    o["pending"] = fc.pending;
     j[id] = std::move(o);
   }
+  return j.dump();
+}
+
+std::string localizationJson(const PipelineReport& r) {
+  const nlohmann::ordered_json j = {{"state", fusion::toString(r.state)},
+                                    {"reason", r.state_reason},
+                                    {"started_how", r.started_how},
+                                    {"starts", r.starts},
+                                    {"recoveries", r.recoveries},
+                                    {"recovery_reasons", r.recovery_reasons},
+                                    {"degradations", r.degradations},
+                                    {"losses", r.losses},
+                                    {"clock_resets", r.clock_resets},
+                                    {"inputs_dropped_by_reset", r.inputs_dropped_by_reset},
+                                    {"events", r.first_events}};
   return j.dump();
 }
 

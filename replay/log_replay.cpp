@@ -127,7 +127,7 @@ std::vector<Event> decodeAll(MessageSource& source, const pipeline::Config& conf
           continue;
         }
         case InputRole::kRsuFix:
-          e.input = pipeline::fixFromMessage(std::get<io::StampedPose>(decoded), use.rsu_id);
+          e.input = pipeline::fixFromMessage(decoded, use.rsu_id);
           break;
         case InputRole::kTwist:
           e.input = pipeline::twistFromMessage(decoded, input, config.messages, fallback);
@@ -259,6 +259,8 @@ void drive(std::vector<Event>& events, const pipeline::Config& config, const Rep
   const bool keep = options.keep_filter_inputs;
   pipe.onEstimate([&](const fusion::Estimate& e) {
     result.fused.push_back({e.stamp, e.pose});
+    result.fused_sd.emplace_back(std::sqrt(e.pose_covariance(0, 0)), std::sqrt(e.pose_covariance(1, 1)));
+    result.fused_localization.push_back(e.localization);
     if (keep) {
       result.fused_states.emplace_back(e.stamp, e.state);
       result.fused_state_covariances.push_back(e.state_covariance);
@@ -292,6 +294,7 @@ void drive(std::vector<Event>& events, const pipeline::Config& config, const Rep
   }
   if (options.progress) options.progress(1.0);
   const pipeline::PipelineReport report = pipe.report();
+  result.pipeline_report = report;
   result.sources = report.sources;
   result.unknown_source_inputs = report.unknown_source_inputs;
   result.ndt_used = report.ndt_used;

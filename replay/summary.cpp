@@ -72,7 +72,8 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
     j["lidar_mount_yaw"] = {{"yaw_rad", mount_yaw}, {"compared_m", mount_yaw_distance}};
     j["lidar_pose"] = {{"xyz_rpy", std::vector<double>(lidar_pose.data(), lidar_pose.data() + 6)}, {"from", lidar_pose_from}};
   }
-  if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes));
+  if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes, pipeline_report.filter_of_fixes));
+  j["localization"] = nlohmann::ordered_json::parse(pipeline::localizationJson(pipeline_report));
   j["rejections_first"] = rejections;
   return j.dump(2) + "\n";
 }
@@ -80,11 +81,17 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
 void ReplayResult::writeErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
-  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg\n";
-  char line[320];
+  out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg,sd_x_m,sd_y_m,state\n";
+  // Each tick's reported deviations and state, by stamp (the last estimate given out at a stamp).
+  std::map<Stamp, std::size_t> tick;
+  for (std::size_t i = 0; i < fused.size() && i < fused_sd.size() && i < fused_localization.size(); ++i) tick[fused[i].stamp] = i;
+  char line[360];
   for (const ErrorSample& s : errors) {
-    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f\n", formatSeconds(s.stamp).c_str(), s.estimate.x(),
-                  s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI);
+    const auto t = tick.find(s.stamp);
+    const Eigen::Vector2d sd = t == tick.end() ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()) : fused_sd[t->second];
+    const char* state = t == tick.end() ? "" : fusion::toString(fused_localization[t->second]);
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%s\n", formatSeconds(s.stamp).c_str(), s.estimate.x(),
+                  s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI, sd.x(), sd.y(), state);
     out << line;
   }
 }

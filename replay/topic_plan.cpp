@@ -17,7 +17,7 @@ bool canServe(InputRole role, MessageKind kind) {
     case InputRole::kScan:
       return kind == MessageKind::kPointCloud2;
     case InputRole::kRsuFix:
-      return kind == MessageKind::kPoseWithCovarianceStamped;
+      return kind == MessageKind::kPoseWithCovarianceStamped || kind == MessageKind::kOdometry;
     case InputRole::kPose:
     case InputRole::kGroundTruth:
       return kind == MessageKind::kPoseWithCovarianceStamped || kind == MessageKind::kPoseStamped || kind == MessageKind::kOdometry;
@@ -39,7 +39,9 @@ InputRole defaultRole(const std::string& topic, MessageKind kind, bool have_map,
     case MessageKind::kPoseWithCovarianceStamped:
       if (truth_name) return InputRole::kGroundTruth;
       return rsu_topic ? InputRole::kRsuFix : InputRole::kPose;
-    case MessageKind::kOdometry: return truth_name ? InputRole::kGroundTruth : InputRole::kTwist;
+    case MessageKind::kOdometry:
+      if (truth_name) return InputRole::kGroundTruth;
+      return rsu_topic ? InputRole::kRsuFix : InputRole::kTwist;
     case MessageKind::kTwistWithCovarianceStamped:
     case MessageKind::kImu: return InputRole::kTwist;
     case MessageKind::kPoseStamped:
@@ -66,7 +68,7 @@ InputRole defaultRole(const std::string& topic, MessageKind kind, bool have_map,
 std::optional<std::string> rsuOfTopic(const std::string& topic, const rsu_client::RsuRegistry* registry) {
   if (!registry) return std::nullopt;
   for (const rsu_client::RsuInfo& rsu : registry->rsus())
-    if (rsu_client::fixTopic(rsu.id) == topic) return rsu.id;
+    if (rsu_client::fixTopic(rsu.id) == topic || rsu_client::addressedFixTopic(rsu.id) == topic) return rsu.id;
   return std::nullopt;
 }
 

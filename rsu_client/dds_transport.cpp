@@ -11,10 +11,13 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <thread>
 
+#include "OdometryPubSubTypes.h"
 #include "PoseWithCovarianceStampedPubSubTypes.h"
 #include "VehicleDimensionsPubSubTypes.h"
 #include "guarded_type.hpp"
@@ -27,9 +30,11 @@ namespace coloc::rsu_client {
 
 namespace dds = eprosima::fastdds::dds;
 using RosPose = geometry_msgs::msg::PoseWithCovarianceStamped;
+using RosOdometry = nav_msgs::msg::Odometry;
 using RosDimensions = coloc_msgs::msg::VehicleDimensions;
 
 std::string fixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/fix"; }
+std::string addressedFixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/addressed_fix"; }
 
 Stamp systemNow() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -87,22 +92,29 @@ struct FixSubscriber::Impl : public dds::DataReaderListener {
   AtomicSampleCounters counters;
   std::function<void(const std::string&)> on_refused;
   dds::TypeSupport type{new GuardedType<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>("an RSU fix topic", &counters, &on_refused)};
-  std::vector<std::pair<dds::DataReader*, std::string>> readers;  ///< reader and its RSU id
+  dds::TypeSupport addressed_type{new GuardedType<nav_msgs::msg::OdometryPubSubType>("an RSU addressed fix topic", &counters, &on_refused)};
+  struct Reader {
+    dds::DataReader* reader;
+    std::string rsu_id;
+    bool addressed;
+  };
+  std::vector<Reader> readers;
   Callback callback;
   std::atomic<int> matched{0};
 
-  void on_data_available(dds::DataReader* reader) override {
-    std::string rsu_id;
-    for (const auto& [r, id] : readers)
-      if (r == reader) rsu_id = id;
-    RosPose msg;
+  template <typename Message>
+  void takeAll(dds::DataReader* reader, const std::string& rsu_id) {
+    Message msg;
     dds::SampleInfo info;
     while (reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       const Stamp received = systemNow();
-      const RsuFix fix = fixFromSample(msg, rsu_id);
-      callback(fix, received);
+      callback(fixFromSample(msg, rsu_id), received);
     }
+  }
+  void on_data_available(dds::DataReader* reader) override {
+    for (const Reader& r : readers)
+      if (r.reader == reader) return r.addressed ? takeAll<RosOdometry>(reader, r.rsu_id) : takeAll<RosPose>(reader, r.rsu_id);
   }
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
     matched += status.current_count_change;
@@ -118,15 +130,17 @@ FixSubscriber::FixSubscriber(const DdsConfig& config, const std::vector<std::str
   impl_->participant = createParticipant(config);
   dds::Subscriber* subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (!subscriber) throw Error("DDS: cannot create a subscriber");
-  impl_->readers.reserve(rsu_ids.size());
-  for (const std::string& id : rsu_ids) {
-    dds::Topic* topic = topicFor(impl_->participant, fixTopic(id), impl_->type);
-    // Readers are listed before they exist so that the listener never sees an unknown one.
-    impl_->readers.emplace_back(nullptr, id);
-    dds::DataReader* reader = subscriber->create_datareader(topic, readerQos(config), impl_.get());
-    if (!reader) throw Error("DDS: cannot subscribe to " + ddsTopicName(fixTopic(id)));
-    impl_->readers.back().first = reader;
-  }
+  impl_->readers.reserve(2 * rsu_ids.size());
+  for (const std::string& id : rsu_ids)
+    for (const bool addressed : {true, false}) {
+      const std::string name = addressed ? addressedFixTopic(id) : fixTopic(id);
+      dds::Topic* topic = topicFor(impl_->participant, name, addressed ? impl_->addressed_type : impl_->type);
+      // Readers are listed before they exist so that the listener never sees an unknown one.
+      impl_->readers.push_back({nullptr, id, addressed});
+      dds::DataReader* reader = subscriber->create_datareader(topic, readerQos(config), impl_.get());
+      if (!reader) throw Error("DDS: cannot subscribe to " + ddsTopicName(name));
+      impl_->readers.back().reader = reader;
+    }
 }
 
 FixSubscriber::~FixSubscriber() = default;
@@ -135,40 +149,59 @@ SampleCounters FixSubscriber::sampleCounters() const { return impl_->counters.sn
 
 struct FixPublisher::Impl {
   dds::TypeSupport type{new geometry_msgs::msg::PoseWithCovarianceStampedPubSubType()};
-  dds::DataWriter* writer = nullptr;
-  MatchCounter listener;
+  dds::TypeSupport addressed_type{new nav_msgs::msg::OdometryPubSubType()};
+  dds::DataWriter* writer = nullptr;  ///< unaddressed fixes
+  dds::DataWriter* addressed_writer = nullptr;
+  MatchCounter listener, addressed_listener;
   OwnedParticipant participant;  // last member: deleted first
 };
 
-FixPublisher::FixPublisher(const DdsConfig& config, const std::string& rsu_id) : impl_(std::make_unique<Impl>()) {
+FixPublisher::FixPublisher(const DdsConfig& config, const std::string& rsu_id, bool addressed) : impl_(std::make_unique<Impl>()) {
   impl_->participant = createParticipant(config);
   dds::Publisher* publisher = impl_->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   if (!publisher) throw Error("DDS: cannot create a publisher");
-  dds::Topic* topic = topicFor(impl_->participant, fixTopic(rsu_id), impl_->type);
-  impl_->writer = publisher->create_datawriter(topic, writerQos(config), &impl_->listener);
-  if (!impl_->writer) throw Error("DDS: cannot publish on " + ddsTopicName(fixTopic(rsu_id)) + " (not permitted?)");
+  const std::string name = addressed ? addressedFixTopic(rsu_id) : fixTopic(rsu_id);
+  dds::Topic* topic = topicFor(impl_->participant, name, addressed ? impl_->addressed_type : impl_->type);
+  dds::DataWriter*& writer = addressed ? impl_->addressed_writer : impl_->writer;
+  writer = publisher->create_datawriter(topic, writerQos(config), addressed ? &impl_->addressed_listener : &impl_->listener);
+  if (!writer) throw Error("DDS: cannot publish on " + ddsTopicName(name) + " (not permitted?)");
 }
 
 FixPublisher::~FixPublisher() = default;
 
 void FixPublisher::publish(const RsuFix& fix, double variance) {
-  RosPose msg;
-  setStamp(msg.header(), fix.stamp, "map");
-  msg.pose().pose().position().x(fix.x);
-  msg.pose().pose().position().y(fix.y);
-  msg.pose().pose().position().z(0.0);
+  geometry_msgs::msg::PoseWithCovariance pose;
+  pose.pose().position().x(fix.x);
+  pose.pose().position().y(fix.y);
+  pose.pose().position().z(0.0);
   const double yaw = fix.yaw.value_or(0.0);
-  msg.pose().pose().orientation().z(std::sin(0.5 * yaw));
-  msg.pose().pose().orientation().w(std::cos(0.5 * yaw));
+  pose.pose().orientation().z(std::sin(0.5 * yaw));
+  pose.pose().orientation().w(std::cos(0.5 * yaw));
   std::array<double, 36> covariance{};
   covariance[0] = covariance[7] = variance;
   covariance[14] = covariance[21] = covariance[28] = covariance[35] = std::numeric_limits<double>::infinity();
-  msg.pose().covariance(covariance);
+  pose.covariance(covariance);
+  if (impl_->addressed_writer) {
+    if (!fix.station_id) throw Error("RSU fix: an addressed publisher needs the fix's station id");
+    RosOdometry msg;
+    setStamp(msg.header(), fix.stamp, "map");
+    msg.child_frame_id(std::to_string(*fix.station_id));
+    msg.pose(pose);
+    // The twist is not part of a fix: zero, and its covariance says it is not measured.
+    std::array<double, 36> unknown{};
+    for (int i = 0; i < 6; ++i) unknown[7 * i] = -1.0;
+    msg.twist().covariance(unknown);
+    impl_->addressed_writer->write(&msg);
+    return;
+  }
+  RosPose msg;
+  setStamp(msg.header(), fix.stamp, "map");
+  msg.pose(pose);
   impl_->writer->write(&msg);
 }
 
 bool FixPublisher::waitForSubscribers(int count, std::chrono::milliseconds timeout) {
-  return waitFor(impl_->listener.matched, count, timeout);
+  return waitFor(impl_->addressed_writer ? impl_->addressed_listener.matched : impl_->listener.matched, count, timeout);
 }
 
 // ---- vehicle dimensions ------------------------------------------------------------------------

@@ -22,6 +22,9 @@ const char* toString(FixRejection reason) {
     case FixRejection::kWrongFrame: return "wrong_frame";
     case FixRejection::kBadCovariance: return "bad_covariance";
     case FixRejection::kBadStamp: return "bad_stamp";
+    case FixRejection::kBadAddress: return "bad_address";
+    case FixRejection::kAddressedToAnother: return "addressed_to_another";
+    case FixRejection::kUnaddressed: return "unaddressed";
   }
   return "?";
 }
@@ -30,7 +33,20 @@ std::vector<std::pair<const char*, std::uint64_t>> refusals(const FixCounters& c
   using R = FixRejection;
   return {{toString(R::kUnknownRsu), c.unknown_rsu},   {toString(R::kNonFinite), c.non_finite},     {toString(R::kOutOfCoverage), c.out_of_coverage},
           {toString(R::kStale), c.stale},              {toString(R::kFromFuture), c.from_future},   {toString(R::kDuplicate), c.duplicate},
-          {toString(R::kWrongFrame), c.wrong_frame},   {toString(R::kBadCovariance), c.bad_covariance}, {toString(R::kBadStamp), c.bad_stamp}};
+          {toString(R::kWrongFrame), c.wrong_frame},   {toString(R::kBadCovariance), c.bad_covariance}, {toString(R::kBadStamp), c.bad_stamp},
+          {toString(R::kBadAddress), c.bad_address},   {toString(R::kAddressedToAnother), c.addressed_to_another},
+          {toString(R::kUnaddressed), c.unaddressed}};
+}
+
+std::optional<std::uint32_t> parseStationId(const std::string& text) {
+  if (text.empty() || text.size() > 10) return std::nullopt;
+  std::uint64_t value = 0;
+  for (const char ch : text) {
+    if (ch < '0' || ch > '9') return std::nullopt;
+    value = value * 10 + static_cast<std::uint64_t>(ch - '0');
+  }
+  if (value > 0xFFFFFFFFull) return std::nullopt;
+  return static_cast<std::uint32_t>(value);
 }
 
 FixChecker::FixChecker(RsuRegistry registry, FixCheckConfig config) : registry_(std::move(registry)), config_(config) {}
@@ -74,7 +90,27 @@ FixVerdict FixChecker::check(const RsuFix& fix, Stamp now) {
     return reject(FixRejection::kNonFinite, "position or yaw is not finite", c.non_finite);
   if (fix.sent)
     if (FixVerdict v = checkSent(fix, *rsu, c); !v.accepted()) return v;
+  if (FixVerdict v = checkAddress(fix, c); !v.accepted()) return v;
   return checkKnown(rsu->calibration ? corrected(fix, *rsu) : fix, now, *rsu, c);
+}
+
+FixVerdict FixChecker::checkAddress(const RsuFix& fix, FixCounters& c) const {
+  auto reject = [&](FixRejection reason, const std::string& why, std::uint64_t& counter) { return rejected(fix, reason, why, counter); };
+  if (!fix.station_id) {
+    if (config_.accept_unaddressed) return {};
+    return reject(FixRejection::kUnaddressed,
+                  "the fix names no vehicle; with more than one connected vehicle it may be another's (rsu.accept_unaddressed takes such fixes)",
+                  c.unaddressed);
+  }
+  if (!config_.station_id)
+    return reject(FixRejection::kAddressedToAnother,
+                  "addressed to station " + std::to_string(*fix.station_id) + ", and this vehicle has no station id (rsu.station_id)",
+                  c.addressed_to_another);
+  if (*fix.station_id != *config_.station_id)
+    return reject(FixRejection::kAddressedToAnother,
+                  "addressed to station " + std::to_string(*fix.station_id) + ", this vehicle is " + std::to_string(*config_.station_id),
+                  c.addressed_to_another);
+  return {};
 }
 
 FixVerdict FixChecker::checkSent(const RsuFix& fix, const RsuInfo& rsu, FixCounters& c) const {
@@ -91,6 +127,16 @@ FixVerdict FixChecker::checkSent(const RsuFix& fix, const RsuInfo& rsu, FixCount
     return reject(FixRejection::kWrongFrame, "frame_id is not UTF-8 text", c.wrong_frame);
   if (frame != registry_.mapFrame())
     return reject(FixRejection::kWrongFrame, "frame '" + frame + "', the registry's map frame is '" + registry_.mapFrame() + "'", c.wrong_frame);
+  if (sent.child_frame_id) {
+    const std::string& child = *sent.child_frame_id;
+    if (!parseStationId(child) || !fix.station_id || *fix.station_id != *parseStationId(child)) {
+      const bool printable = child.size() <= 16 && isValidUtf8(child.data(), child.size()) && child.find('\0') == std::string::npos;
+      return reject(FixRejection::kBadAddress,
+                    "child_frame_id " + (printable ? "'" + child + "'" : std::to_string(child.size()) + " bytes") +
+                        " is not a station id (decimal, 0 to 4294967295)",
+                    c.bad_address);
+    }
+  }
   // The covariance: each entry finite or +inf (+inf: not measured), the matrix symmetric with a
   // non-negative diagonal, and x and y measured, since a fix is nothing but x and y.
   const Matrix6d& m = sent.covariance;
@@ -143,12 +189,14 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
     return reject(FixRejection::kFromFuture, "stamped " + formatSeconds(fix.stamp - now) + " s after its arrival", c.from_future);
   if (fix.stamp < now - fromSeconds(config_.max_age))
     return reject(FixRejection::kStale, formatSeconds(now - fix.stamp) + " s old (limit " + std::to_string(config_.max_age) + " s)", c.stale);
-  std::deque<Stamp>& seen = recent_[fix.rsu_id];
+  // One RSU frame gives a fix per vehicle it sees, all with the frame's stamp: a duplicate is the same
+  // stamp for the same vehicle.
+  std::deque<Stamp>& seen = recent_[{fix.rsu_id, fix.station_id}];
   while (!seen.empty() && seen.front() < now - fromSeconds(config_.max_age)) seen.pop_front();
   if (std::find(seen.begin(), seen.end(), fix.stamp) != seen.end())
     return reject(FixRejection::kDuplicate, "a fix with this stamp was already received", c.duplicate);
   seen.push_back(fix.stamp);
-  ++c.accepted;
+  ++c.passed_checks;
   const double variance = registry_.variance(*rsu);
   v.measurement.stamp = fix.stamp;
   v.measurement.pose.position = {fix.x, fix.y, 0.0};

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Creates a DDS Security setup for coloc in OUT_DIR, as a road operator would: one CA that signs the
 # identities of the roadside units and the vehicle and the governance and permissions documents.
-# Permissions let each RSU publish only its own fix topic and the vehicle publish only its dimensions.
+# Permissions let each RSU publish only its own fix topics (addressed and unaddressed) and the vehicle publish only its dimensions.
 #
 #   scripts/make-dds-security.sh OUT_DIR [RSU_ID ...]      (default RSUs: rsu_a rsu_b)
 #
@@ -96,8 +96,8 @@ sign governance operator_ca
 fix_topics=""
 for id in "${rsus[@]}"; do
   make_identity "$id" operator_ca
-  permissions "$id" "rt/rsu/$id/fix" "rt/vehicle/dimensions" operator_ca
-  fix_topics="$fix_topics rt/rsu/$id/fix"
+  permissions "$id" "rt/rsu/$id/addressed_fix rt/rsu/$id/fix" "rt/vehicle/dimensions" operator_ca
+  fix_topics="$fix_topics rt/rsu/$id/addressed_fix rt/rsu/$id/fix"
 done
 make_identity vehicle operator_ca
 permissions vehicle "rt/vehicle/dimensions" "$fix_topics" operator_ca
@@ -112,7 +112,7 @@ mkdir -p rogue
   cp ../governance.xml governance.xml
   sign governance rogue_ca
   make_identity intruder_rogue rogue_ca
-  permissions intruder_rogue "rt/rsu/${rsus[0]}/fix" "" rogue_ca
+  permissions intruder_rogue "rt/rsu/${rsus[0]}/addressed_fix rt/rsu/${rsus[0]}/fix" "" rogue_ca
   rm -f ./*.srl
 )
 # An intruder the operator knows, allowed to listen to fixes but not to send them.

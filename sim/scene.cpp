@@ -178,7 +178,9 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
   if (route["speed"]) s.speed.cruise = r.positive(route["speed"], "route.speed");
   if (route["acceleration"]) s.speed.acceleration = r.positive(route["acceleration"], "route.acceleration");
   if (root["vehicle"]) {
-    r.keys(root["vehicle"], "vehicle", {"lidar", "lidar_height", "odometry"});
+    r.keys(root["vehicle"], "vehicle", {"lidar", "lidar_height", "odometry", "station_id"});
+    if (root["vehicle"]["station_id"])
+      s.vehicle_station_id = static_cast<std::uint32_t>(r.integer(root["vehicle"]["station_id"], "vehicle.station_id", 0, 4294967295LL));
     if (root["vehicle"]["lidar"]) s.vehicle_lidar = r.text(root["vehicle"]["lidar"], "vehicle.lidar");
     if (s.vehicle_lidar != "VLP-16" && s.vehicle_lidar != "VLP-32C")
       r.fail(root["vehicle"]["lidar"], "vehicle.lidar", "unknown LiDAR model '" + s.vehicle_lidar + "' (VLP-16, VLP-32C)");

@@ -11,6 +11,7 @@
 #include "log_options.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "progress.hpp"
+#include "report_lines.hpp"
 #include "coloc/replay/svg_plot.hpp"
 
 namespace coloc::tools {
@@ -48,11 +49,9 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 (unsigned long long)c.from_future, (unsigned long long)c.invalid, (unsigned long long)c.not_initialized,
                 (unsigned long long)c.pending);
   }
-  for (const auto& [id, c] : r.fixes) {
-    std::printf("  RSU %s: %llu fixes received, %llu accepted; refused:", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted);
-    for (const auto& [reason, count] : rsu_client::refusals(c)) std::printf(" %s %llu", reason, (unsigned long long)count);
-    std::printf("\n");
-  }
+  for (const auto& [id, c] : r.fixes) std::printf("  %s\n", fixLine(id, r.pipeline_report).c_str());
+  std::printf("  localization: %s\n", localizationLine(r.pipeline_report).c_str());
+  for (const std::string& line : r.pipeline_report.first_events) std::printf("    %s\n", line.c_str());
   for (const TopicUse& t : r.topics)
     if (!t.first_error.empty()) std::printf("  first decode error: %s\n", t.first_error.c_str());
   if (r.ndt_used) {

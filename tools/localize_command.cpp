@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "number_checks.hpp"
 #include "dds_options.hpp"
+#include "report_lines.hpp"
 #include "teardown_watchdog.hpp"
 
 namespace coloc::tools {
@@ -23,9 +24,10 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void requestStop(int) { g_stop = true; }
 
-std::uint64_t accepted(const pipeline::PipelineReport& r) {
+// Fixes applied by the filter, over every RSU.
+std::uint64_t applied(const pipeline::PipelineReport& r) {
   std::uint64_t n = 0;
-  for (const auto& [id, c] : r.fixes) n += c.accepted;
+  for (const auto& [id, c] : r.filter_of_fixes) n += c.applied;
   return n;
 }
 
@@ -33,20 +35,28 @@ void printStatus(const live::LiveStatus& s, double elapsed) {
   std::printf("[%6.1f s] ", elapsed);
   if (s.estimate) {
     const auto& e = *s.estimate;
-    std::printf("t=%s x=%.3f y=%.3f yaw=%.2f deg sd=%.3f m v=%.2f m/s", formatSeconds(e.stamp).c_str(), e.pose.position.x(),
-                e.pose.position.y(), rollPitchYaw(e.pose.orientation)[2] * 180.0 / M_PI,
+    std::printf("%s t=%s x=%.3f y=%.3f yaw=%.2f deg sd=%.3f m v=%.2f m/s", fusion::toString(s.report.state), formatSeconds(e.stamp).c_str(),
+                e.pose.position.x(), e.pose.position.y(), rollPitchYaw(e.pose.orientation)[2] * 180.0 / M_PI,
                 std::sqrt(std::max(0.0, e.pose_covariance(0, 0) + e.pose_covariance(1, 1))), e.linear_velocity.x());
+    if (s.report.state != fusion::LocalizationState::kLocalized && !s.report.state_reason.empty())
+      std::printf(" (%s)", s.report.state_reason.c_str());
   } else {
-    std::printf("not initialised (waiting for an initial pose or a pose source)");
+    std::printf("initialising (%s)", s.report.state_reason.empty() ? "waiting for an initial pose, a pose source or an RSU fix"
+                                                                    : s.report.state_reason.c_str());
   }
   std::printf(" | published %llu", (unsigned long long)s.published);
   if (s.report.ndt_used)
     std::printf(" | ndt %llu/%llu", (unsigned long long)s.report.ndt.poses, (unsigned long long)s.report.ndt.scans);
   if (!s.report.fixes.empty()) {
-    std::uint64_t received = 0;
-    for (const auto& [id, c] : s.report.fixes) received += c.received;
-    std::printf(" | fixes %llu/%llu", (unsigned long long)accepted(s.report), (unsigned long long)received);
+    std::uint64_t received = 0, refused = 0;
+    for (const auto& [id, c] : s.report.fixes) received += c.received, refused += c.received - c.passed_checks;
+    std::uint64_t gated = 0, waiting = 0;
+    for (const auto& [id, c] : s.report.filter_of_fixes) gated += c.gated, waiting += c.not_initialized;
+    std::printf(" | fixes %llu received, %llu refused, %llu gated, %llu before start, %llu applied", (unsigned long long)received,
+                (unsigned long long)refused, (unsigned long long)gated, (unsigned long long)waiting, (unsigned long long)applied(s.report));
   }
+  if (s.report.recoveries || s.report.clock_resets)
+    std::printf(" | recoveries %llu, clock resets %llu", (unsigned long long)s.report.recoveries, (unsigned long long)s.report.clock_resets);
   std::printf(" | rejected %llu | writers %d\n", (unsigned long long)s.report.rejections, s.matched_writers);
   std::fflush(stdout);
 }
@@ -77,6 +87,11 @@ void addLocalizeCommand(CLI::App& app) {
     options.map = map;
     options.use_sim_time = sim_time;
     options.dds = ddsConfig(dds, "coloc_localizer");
+    // Starts, recoveries, state changes and clock resets, as they happen.
+    options.on_event = [](const std::string& line) {
+      std::printf("event: %s\n", line.c_str());
+      std::fflush(stdout);
+    };
     printSecurity(options.dds);
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
@@ -124,8 +139,8 @@ void addLocalizeCommand(CLI::App& app) {
     for (const auto& t : s.topics)
       std::printf("  %-48s %8llu messages %6llu undecodable%s%s\n", t.topic.c_str(), (unsigned long long)t.received,
                   (unsigned long long)t.undecodable, t.first_error.empty() ? "" : "  first: ", t.first_error.c_str());
-    for (const auto& [id, c] : s.report.fixes)
-      std::printf("  RSU %s: %llu fixes received, %llu accepted\n", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted);
+    for (const auto& [id, c] : s.report.fixes) std::printf("  %s\n", fixLine(id, s.report).c_str());
+    std::printf("  localization: %s\n", localizationLine(s.report).c_str());
     for (const auto& line : s.report.first_rejections) std::printf("  rejected: %s\n", line.c_str());
     std::fflush(stdout);
   });

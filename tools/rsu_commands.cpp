@@ -48,7 +48,12 @@ void addRsuListenCommand(CLI::App& app) {
   static int count = 0;
   static double timeout = 0.0, idle = 0.0;
   static std::vector<double> dimensions;
+  static std::int64_t station_id = -1;
+  static bool accept_unaddressed = false;
   cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
+  cmd->add_option("--station-id", station_id, "this vehicle's station id: only fixes addressed to it pass (default: none)")
+      ->check(CLI::Range(static_cast<std::int64_t>(0), static_cast<std::int64_t>(4294967295LL)));
+  cmd->add_flag("--accept-unaddressed", accept_unaddressed, "take fixes that name no vehicle (a setup with one connected vehicle)");
   cmd->add_option("--count", count, "exit after this many fixes (0 = run until --timeout or Ctrl-C)")->check(wholeNumber(0, 1000000000));
   cmd->add_option("--timeout", timeout, "exit after this many seconds (0 = no limit)")->check(finiteNumber(0.0));
   cmd->add_option("--idle-exit", idle, "exit once this many seconds pass without a fix, after the first (0 = never)")->check(finiteNumber(0.0));
@@ -62,7 +67,10 @@ void addRsuListenCommand(CLI::App& app) {
         !(dimensions[0] >= 0.0 && dimensions[0] <= 4294967295.0 && dimensions[0] == std::floor(dimensions[0]) && std::isfinite(dimensions[1]) &&
           dimensions[1] > 0.0 && std::isfinite(dimensions[2]) && dimensions[2] > 0.0))
       throw Error("rsu-listen: --dimensions takes a station id (a whole number below 2^32) and a length and width > 0 in metres");
-    rsu_client::FixChecker checker(rsu_client::RsuRegistry::load(registry_path));
+    rsu_client::FixCheckConfig checks;
+    if (station_id >= 0) checks.station_id = static_cast<std::uint32_t>(station_id);
+    checks.accept_unaddressed = accept_unaddressed;
+    rsu_client::FixChecker checker(rsu_client::RsuRegistry::load(registry_path), checks);
     std::vector<std::string> ids;
     for (const auto& r : checker.registry().rsus()) ids.push_back(r.id);
     const rsu_client::DdsConfig config = ddsConfig(dds, "vehicle");
@@ -92,7 +100,8 @@ void addRsuListenCommand(CLI::App& app) {
     if (!dimensions.empty()) dims = std::make_unique<rsu_client::DimensionsPublisher>(config);
     watchdog.disarm();
     const TeardownWatchdog::ArmOnExit arm_on_exit(watchdog);
-    std::printf("listening on %zu RSU topics (%s), domain %d, %s\n", ids.size(), ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
+    std::printf("listening on %zu RSUs (%s and %s), domain %d, %s\n", ids.size(), ids.empty() ? "" : rsu_client::addressedFixTopic(ids.front()).c_str(),
+                ids.empty() ? "" : rsu_client::fixTopic(ids.front()).c_str(),
                 config.domain, config.loopback_only ? "loopback only" : "every interface");
     std::fflush(stdout);
     const auto start = std::chrono::steady_clock::now();
@@ -111,7 +120,7 @@ void addRsuListenCommand(CLI::App& app) {
     }
     std::lock_guard<std::mutex> lock(mutex);
     for (const auto& [id, c] : checker.counters()) {
-      std::printf("summary %s: received %llu accepted %llu", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.accepted);
+      std::printf("summary %s: received %llu passed the checks %llu", id.c_str(), (unsigned long long)c.received, (unsigned long long)c.passed_checks);
       for (const auto& [reason, count] : rsu_client::refusals(c)) std::printf(" %s %llu", reason, (unsigned long long)count);
       std::printf("\n");
     }
@@ -128,9 +137,13 @@ void addRsuPublishCommand(CLI::App& app) {
   static int generate = 0, wait_subscribers = 1;
   static double rate = 10.0, wait_timeout = 10.0, speed = 10.0;
   static rsu_client::LinkConfig link;
-  static bool dimensions = false;
+  static bool dimensions = false, unaddressed = false;
+  static std::int64_t station_id = -1;
   cmd->add_option("--registry", registry_path, "RSU registry (YAML)")->capture_default_str();
   cmd->add_option("--rsu", rsu, "the RSU id to publish as")->required();
+  cmd->add_option("--station-id", station_id, "the vehicle the fixes are addressed to (its CAM's station id); required unless --unaddressed")
+      ->check(CLI::Range(static_cast<std::int64_t>(0), static_cast<std::int64_t>(4294967295LL)));
+  cmd->add_flag("--unaddressed", unaddressed, "publish on the unaddressed topic /rsu/<id>/fix (a setup with one connected vehicle)");
   cmd->add_option("--from", from, "fixes from a CSV file: t_offset_s,x,y per line");
   cmd->add_option("--generate", generate, "generate this many fixes of a vehicle driving past the RSU")->check(wholeNumber(0, 1000000));
   cmd->add_option("--speed", speed, "speed of the generated vehicle, m/s")->check(finiteNumber(0.0, 100.0))->capture_default_str();
@@ -146,6 +159,8 @@ void addRsuPublishCommand(CLI::App& app) {
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix); default: the RSU id");
   addDdsOptions(cmd, dds);
   cmd->callback([] {
+    if (unaddressed == (station_id >= 0))
+      throw Error("rsu-publish: give the vehicle's --station-id (addressed fixes, the protocol) or --unaddressed, one of the two");
     const rsu_client::RsuRegistry registry = rsu_client::RsuRegistry::load(registry_path);
     const rsu_client::RsuInfo* info = registry.find(rsu);
     if (!info) throw Error(registry_path + ": no RSU '" + rsu + "'");
@@ -160,7 +175,7 @@ void addRsuPublishCommand(CLI::App& app) {
     printSecurity(config);
     TeardownWatchdog watchdog("rsu-publish");
     watchdog.arm(1);  // a participant that fails to come up is deleted at once
-    rsu_client::FixPublisher publisher(config, rsu);
+    rsu_client::FixPublisher publisher(config, rsu, !unaddressed);
     std::mutex print;
     std::atomic<bool> have_dimensions{false};
     std::unique_ptr<rsu_client::DimensionsSubscriber> dims;
@@ -188,6 +203,7 @@ void addRsuPublishCommand(CLI::App& app) {
       // Fixes are stamped at capture on the vehicle's clock; the emulated link decides when (and if) each arrives.
       rsu_client::RsuFix fix = planned;
       fix.stamp = start + planned.stamp;
+      if (!unaddressed) fix.station_id = static_cast<std::uint32_t>(station_id);
       std::this_thread::sleep_until(std::chrono::system_clock::time_point(std::chrono::nanoseconds(fix.stamp)));
       const std::optional<Stamp> delivery = emulator.transmit(fix.stamp);
       if (!delivery) {
@@ -202,7 +218,8 @@ void addRsuPublishCommand(CLI::App& app) {
     if (dimensions)  // the vehicle's CAMs come twice a second: a short wait is enough to have one
       for (int i = 0; i < 200 && !have_dimensions.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     std::lock_guard<std::mutex> lock(print);
-    std::printf("published %d fixes as %s, %d dropped by the emulated link\n", sent, rsu.c_str(), dropped);
+    std::printf("published %d fixes as %s%s, %d dropped by the emulated link\n", sent, rsu.c_str(),
+                unaddressed ? " (unaddressed)" : (" to station " + std::to_string(station_id)).c_str(), dropped);
   });
 }
 

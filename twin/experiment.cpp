@@ -127,6 +127,7 @@ struct Job {
   pipeline::Config config;
   std::optional<rsu_client::RsuRegistry> registry;  ///< the fused RSUs, their fixes through the registry's checks
   std::vector<std::string> fix_topics;  ///< the fused RSUs' topics (every RSU of the LiDAR model), none for NDT only
+  std::vector<std::string> fix_sources;  ///< the filter's sources of the same RSUs
   std::vector<Eigen::Vector2d> rsu_positions;
   bool smooth = false;     ///< also smooth the log: `smoothed`
   bool calibrate = false;  ///< smooth with the RSUs' calibrations: `calibrations`, `calibrated`
@@ -237,7 +238,7 @@ void runJob(Job& job) {
   if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) job.run.ndt = c->second;
   const auto fused = [&](const std::string& topic) { return std::find(job.fix_topics.begin(), job.fix_topics.end(), topic) != job.fix_topics.end(); };
   for (const fusion::SourceReport& s : r.sources)
-    if (fused(s.name)) {
+    if (std::find(job.fix_sources.begin(), job.fix_sources.end(), s.name) != job.fix_sources.end()) {
       job.run.fixes_applied += s.counters.applied;
       job.run.fixes_gated += s.counters.gated;
     }
@@ -558,6 +559,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.map = maps[drive.site];
       job.cache = cache;
       job.config = fuse;
+      job.config.rsu.checks.station_id = scenario.vehicle_station_id;  // the ego takes the fixes addressed to it
       job.rsu_positions = rsu_positions;
       if (const auto& v = ndt_variance[drive.site]) {
         Vector6d& cov = job.config.ndt.source.ndt.fixed_covariance;
@@ -577,11 +579,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       std::vector<rsu_client::RsuInfo> fused;
       for (const sim::ScenarioRsu& r : scenario.rsus) {
         pipeline::InputConfig input;
-        const std::string topic = rsu_client::fixTopic(r.id);
+        const std::string topic = rsu_client::addressedFixTopic(r.id);
         if (r.lidar_model == lidar) {
           // The fixes pass the same checks as fixes over DDS; the registry carries the variance chosen.
           input.role = pipeline::InputRole::kRsuFix;
           job.fix_topics.push_back(topic);
+          job.fix_sources.push_back(rsu_client::fixTopic(r.id));
           rsu_client::RsuInfo info = registryEntry(r);
           info.calibrated_variance = varianceFor(how, r);
           const bool same_installation = drive.variant.empty() || drive.variant == "RSU height" || drive.variant == "speed";
@@ -694,8 +697,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         Job perfect = makeJob(lidar, 0.0, 0.0, kNextPerfect, main_covariance);
         std::vector<rsu_client::RsuInfo> twins;
         perfect.fix_topics.clear();
+        perfect.fix_sources.clear();
         for (const sim::ScenarioRsu& r : scenario.rsus) {
-          const std::string own = rsu_client::fixTopic(r.id), twin = rsu_client::fixTopic(perfectRsuId(r.id));
+          const std::string own = rsu_client::addressedFixTopic(r.id), twin = rsu_client::addressedFixTopic(perfectRsuId(r.id));
           perfect.config.inputs[twin] = perfect.config.inputs[own];
           perfect.config.inputs[own] = pipeline::InputConfig();
           if (r.lidar_model != lidar) continue;
@@ -707,13 +711,14 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           info.calibrated_variance = perfect.registry->find(r.id)->calibrated_variance;
           twins.push_back(info);
           perfect.fix_topics.push_back(twin);
+          perfect.fix_sources.push_back(rsu_client::fixTopic(perfectRsuId(r.id)));
         }
         perfect.registry = rsu_client::RsuRegistry(twins, rsu_client::CovariancePlacement::kPublished);
         jobs.push_back(std::move(perfect));
       }
       // The twins' topics are not the other replays' inputs.
       for (Job& j : jobs)
-        for (const sim::ScenarioRsu& r : scenario.rsus) j.config.inputs.emplace(rsu_client::fixTopic(perfectRsuId(r.id)), pipeline::InputConfig());
+        for (const sim::ScenarioRsu& r : scenario.rsus) j.config.inputs.emplace(rsu_client::addressedFixTopic(perfectRsuId(r.id)), pipeline::InputConfig());
     } else {
       if (drive.variant == "speed") jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
       for (const std::string& lidar : config.lidars) jobs.push_back(makeJob(lidar, 0.0, 0.0, variant, main_covariance));

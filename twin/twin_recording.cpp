@@ -282,6 +282,21 @@ rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& r) {
 
 std::string perfectRsuId(const std::string& id) { return id + "_perfect"; }
 
+io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, double variance, std::uint32_t station_id) {
+  io::Odometry fix;
+  fix.header = {stamp, "map"};
+  fix.child_frame_id = std::to_string(station_id);
+  fix.pose.stamp = stamp;
+  fix.pose.pose.position = {position.x(), position.y(), 0.0};
+  fix.pose.covariance = Matrix6d::Zero();
+  fix.pose.covariance.diagonal() << variance, variance, kInfinity, kInfinity, kInfinity, kInfinity;
+  // Not part of a fix: its covariance says so (REP 145's -1).
+  fix.twist.stamp = stamp;
+  fix.twist.covariance = Matrix6d::Zero();
+  fix.twist.covariance.diagonal().setConstant(-1.0);
+  return fix;
+}
+
 TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordingOptions& options) {
   const auto wall_start = Clock::now();
   const std::string& out_dir = options.out_dir;
@@ -369,9 +384,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   bag.addTopic(topic("/points", "sensor_msgs/msg/PointCloud2"));
   bag.addTopic(topic("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
   bag.addTopic(topic("/ground_truth/odom", "nav_msgs/msg/Odometry"));
-  for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::fixTopic(r.info.id), "geometry_msgs/msg/PoseWithCovarianceStamped"));
+  // The RSUs address each fix to the vehicle it is of (the station id of its CAM): the protocol.
+  for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::addressedFixTopic(r.info.id), "nav_msgs/msg/Odometry"));
   if (options.perfect_rsus)
-    for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::fixTopic(perfectRsuId(r.info.id)), "geometry_msgs/msg/PoseWithCovarianceStamped"));
+    for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::addressedFixTopic(perfectRsuId(r.info.id)), "nav_msgs/msg/Odometry"));
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
@@ -572,19 +588,14 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         ++summary.fixes_lost;
         continue;
       }
-      io::StampedPose fix;
-      fix.header = {at(capture) + fromSeconds(stamp_offset), "map"};
-      fix.measurement.pose.position = {d.position.x(), d.position.y(), 0.0};
-      fix.measurement.covariance = Matrix6d::Zero();
-      fix.measurement.covariance.diagonal() << r.variance, r.variance, kInfinity, kInfinity, kInfinity, kInfinity;
-      bag.write(rsu_client::fixTopic(r.info.id), *delivered, io::encodePoseWithCovarianceStamped(fix));
+      bag.write(rsu_client::addressedFixTopic(r.info.id), *delivered,
+                io::encodeOdometry(addressedFix(at(capture) + fromSeconds(stamp_offset), d.position, r.variance, scenario.vehicle_station_id)));
       ++summary.fixes;
       if (options.perfect_rsus) {
         // Through the true pose, as the same expression computes it with a survey error of zero.
         const Eigen::Vector2d perfect = r.info.position + true_yaw * local;
-        fix.header.stamp = at(capture) + fromSeconds(jitter);
-        fix.measurement.pose.position = {perfect.x(), perfect.y(), 0.0};
-        bag.write(rsu_client::fixTopic(perfectRsuId(r.info.id)), *delivered, io::encodePoseWithCovarianceStamped(fix));
+        bag.write(rsu_client::addressedFixTopic(perfectRsuId(r.info.id)), *delivered,
+                  io::encodeOdometry(addressedFix(at(capture) + fromSeconds(jitter), perfect, r.variance, scenario.vehicle_station_id)));
       }
     }
   }
@@ -625,7 +636,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   fuse << "# coloc fuse " << out_dir << "/log --map " << summary.map_dir << " --config " << out_dir << "/fuse.yaml\n"
        << "pipeline:\n  initial_pose: [" << scenario.route_start.x() << ", " << scenario.route_start.y() << ", 0.0, " << scenario.route_heading
        << "]\nndt:\n  lidar_pose: [0.0, 0.0, " << scenario.vehicle_lidar_height << ", 0.0, 0.0, 0.0]\n"
-       << "rsu:\n  registry: rsu.yaml\n";
+       << "rsu:\n  registry: rsu.yaml\n  station_id: " << scenario.vehicle_station_id << "  # the ego's: its fixes are addressed to it\n";
   summary.drive_seconds = drive.duration();
   summary.wall_seconds = since(wall_start);
   return summary;

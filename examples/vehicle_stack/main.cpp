@@ -47,6 +47,7 @@ int main() {
   const coloc::ndt::PointCloud world = street();
   coloc::pipeline::Config config;                   // every default, as config/coloc.yaml lists them
   config.pipeline.initial_pose = Eigen::Vector4d(0.3, 0.2, 0.0, 0.02);  // where the stack believes it starts
+  config.rsu.checks.station_id = 1001;              // this vehicle's CAM station id: the RSU addresses its fixes to it
 
   coloc::rsu_client::RsuInfo rsu;                   // one roadside unit with a VLP-32C at x = 60 m
   rsu.id = "rsu_a";
@@ -76,7 +77,8 @@ int main() {
     if (k % 5 == 0) pipeline.pushScan(scanAt(world, kSpeed * k * 0.02, rng), t, t + 30'000'000);
     if (k == 367) {
       const coloc::Stamp taken = t + 10'000'000;
-      pipeline.pushFix({taken, "rsu_a", kSpeed * coloc::toSeconds(taken - kStart) + 0.004, -0.003, std::nullopt, std::nullopt}, taken + 120'000'000);
+      pipeline.pushFix({taken, "rsu_a", kSpeed * coloc::toSeconds(taken - kStart) + 0.004, -0.003, std::nullopt, std::nullopt, 1001u},
+                       taken + 120'000'000);
     }
     pipeline.runUntil(t + 2'000'000);  // offline here; a live stack calls pipeline.start() instead
   }
@@ -84,10 +86,10 @@ int main() {
   const coloc::pipeline::PipelineReport report = pipeline.report();
   const double truth_x = kSpeed * coloc::toSeconds(last.stamp - kStart);
   const double error = std::hypot(last.pose.position.x() - truth_x, last.pose.position.y());
-  std::printf("estimate at %.2f s: x=%.3f y=%.3f (truth %.3f, 0.000): %.3f m off; %llu ticks, NDT %llu/%llu scans, fixes %llu/%llu accepted\n",
+  std::printf("estimate at %.2f s: x=%.3f y=%.3f (truth %.3f, 0.000): %.3f m off; %llu ticks, NDT %llu/%llu scans, fixes %llu/%llu applied\n",
               coloc::toSeconds(last.stamp - kStart), last.pose.position.x(), last.pose.position.y(), truth_x, error,
               static_cast<unsigned long long>(report.ticks), static_cast<unsigned long long>(report.ndt.poses),
-              static_cast<unsigned long long>(report.ndt.scans), static_cast<unsigned long long>(report.fixes.at("rsu_a").accepted),
+              static_cast<unsigned long long>(report.ndt.scans), static_cast<unsigned long long>(report.filter_of_fixes.at("rsu_a").applied),
               static_cast<unsigned long long>(report.fixes.at("rsu_a").received));
-  return error < 0.10 && report.fixes.at("rsu_a").accepted == 1 ? 0 : 1;
+  return error < 0.10 && report.filter_of_fixes.at("rsu_a").applied == 1 ? 0 : 1;
 }

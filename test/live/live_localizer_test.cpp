@@ -34,6 +34,7 @@ TEST(LiveLocalizer, MalformedAndInvalidSamplesAreCountedAndTheNodeKeepsRunning) 
   LiveOptions options;
   options.registry = rsu_client::RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [0, 0], lidar_model: VLP-32C}\n", "test");
   options.config.live.reliable = true;  // on loopback every loss would be coloc's
+  options.config.rsu.checks.accept_unaddressed = true;  // the intruder writes on the unaddressed topic
   options.dds.domain = 79;
   options.dds.loopback_only = true;  // a unit test talks to nothing beyond 127.0.0.1
   LiveLocalizer localizer(options);
@@ -77,7 +78,7 @@ TEST(LiveLocalizer, MalformedAndInvalidSamplesAreCountedAndTheNodeKeepsRunning) 
   EXPECT_FALSE(t.first_error.empty());
   ASSERT_TRUE(s.report.fixes.count("rsu_a"));
   EXPECT_EQ(s.report.fixes.at("rsu_a").out_of_coverage, 1u);
-  EXPECT_EQ(s.report.fixes.at("rsu_a").accepted, 1u);
+  EXPECT_EQ(s.report.fixes.at("rsu_a").passed_checks, 1u);
   localizer.stop();
 }
 

@@ -41,7 +41,7 @@ mean_error() {
 }
 read -r offline offline_n < <(mean_error "$work/offline/fused.tum")
 read -r live live_n < <(mean_error "$work/live/fused.tum")
-played=$(sed -n 's|^ */rsu/rsu_a/fix *\([0-9]*\)$|\1|p' "$work/play.txt")
+played=$(sed -n 's|^ */rsu/rsu_a/addressed_fix *\([0-9]*\)$|\1|p' "$work/play.txt")
 received=$(sed -n 's|^ *RSU rsu_a: \([0-9]*\) fixes received.*|\1|p' "$work/localize.txt")
 echo "offline mean error $offline m over $offline_n ticks; live $live m over $live_n ticks; fixes played $played, received $received"
 [ "$live" != nan ] || { echo "FAIL: the live localizer gave fewer than 100 estimates on the drive"; exit 1; }

@@ -27,9 +27,14 @@ rsu_client::RsuRegistry oneRsu() {
   return rsu_client::RsuRegistry({rsu}, rsu_client::CovariancePlacement::kPublished);
 }
 
-const Config kConfig;
+// This vehicle is station 1001; its RSU addresses its fixes to it.
+const Config kConfig = [] {
+  Config c;
+  c.rsu.checks.station_id = 1001;
+  return c;
+}();
 
-rsu_client::RsuFix fixAt(Stamp stamp, double x, double y) { return {stamp, "rsu_a", x, y, std::nullopt, std::nullopt}; }
+rsu_client::RsuFix fixAt(Stamp stamp, double x, double y) { return {stamp, "rsu_a", x, y, std::nullopt, std::nullopt, 1001u}; }
 
 // A vehicle at 5 m/s along x from the origin: twists at 50 Hz, a starting pose, and a fix at `fix_stamp`
 // arriving `fix_delay` later. Returns the last estimate.
@@ -94,7 +99,7 @@ TEST(Pipeline, FixesPassTheRegistrysChecksBeforeReachingTheFilter) {
   const PipelineReport r = pipe.report();
   EXPECT_EQ(r.fixes.at("rsu_a").received, 2u);
   EXPECT_EQ(r.fixes.at("rsu_a").out_of_coverage, 1u);
-  EXPECT_EQ(r.fixes.at("rsu_a").accepted, 1u);
+  EXPECT_EQ(r.fixes.at("rsu_a").passed_checks, 1u);
   EXPECT_EQ(r.fixes.at("rsu_x").unknown_rsu, 1u);
   ASSERT_EQ(rejections.size(), 2u);
   EXPECT_NE(rejections[0].find("out_of_coverage"), std::string::npos) << rejections[0];

@@ -40,7 +40,7 @@ TEST(DdsLoopback, FixesArriveOnTheirRsuTopicWithStampAndPosition) {
   FixPublisher publisher(testConfig(71), "rsu_b");
   ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
   const Stamp t0 = systemNow();
-  for (int i = 0; i < 5; ++i) publisher.publish({t0 + i * 100'000'000LL, "rsu_b", 200.0 + i, 6.0, std::nullopt, std::nullopt}, 0.00681);
+  for (int i = 0; i < 5; ++i) publisher.publish({t0 + i * 100'000'000LL, "rsu_b", 200.0 + i, 6.0, std::nullopt, std::nullopt, 1000u + i}, 0.00681);
   ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 5; }, std::chrono::seconds(10)));
   std::lock_guard<std::mutex> lock(mutex);
   for (int i = 0; i < 5; ++i) {
@@ -48,7 +48,26 @@ TEST(DdsLoopback, FixesArriveOnTheirRsuTopicWithStampAndPosition) {
     EXPECT_EQ(received[i].stamp, t0 + i * 100'000'000LL);
     EXPECT_EQ(received[i].x, 200.0 + i);
     EXPECT_FALSE(received[i].yaw.has_value());  // sent with +inf yaw variance: no yaw
+    ASSERT_TRUE(received[i].sent && received[i].sent->child_frame_id);  // on the addressed topic
+    EXPECT_EQ(*received[i].sent->child_frame_id, std::to_string(1000 + i));
+    EXPECT_EQ(received[i].station_id, 1000u + i);  // to the vehicle it names
   }
+}
+
+TEST(DdsLoopback, UnaddressedFixesArriveOnTheirOwnTopicNamingNoVehicle) {
+  std::mutex mutex;
+  std::vector<RsuFix> received;
+  FixSubscriber subscriber(testConfig(72), {"rsu_a"}, [&](const RsuFix& fix, Stamp) {
+    std::lock_guard<std::mutex> lock(mutex);
+    received.push_back(fix);
+  });
+  FixPublisher publisher(testConfig(72), "rsu_a", false);
+  ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
+  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt}, 0.00681);
+  ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 1; }, std::chrono::seconds(10)));
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_FALSE(received[0].station_id.has_value());
+  EXPECT_FALSE(received[0].sent->child_frame_id.has_value());
 }
 
 TEST(DdsLoopback, AnUndecodableFixSampleIsCountedAndTheListenerGoesOn) {
@@ -78,7 +97,7 @@ TEST(DdsLoopback, AnUndecodableFixSampleIsCountedAndTheListenerGoesOn) {
   ASSERT_TRUE(raw.write(std::vector<std::uint8_t>{0x00, 0x01, 0x00, 0x00, 0x10, 0x00}));
   ASSERT_TRUE(waitUntil([&] { const SampleCounters c = subscriber.sampleCounters(); return c.wrong_encapsulation + c.undecodable >= 2; },
                         std::chrono::seconds(10)));
-  FixPublisher publisher(testConfig(73), "rsu_a");
+  FixPublisher publisher(testConfig(73), "rsu_a", false);
   ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
   publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt}, 0.00681);
   ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 1; }, std::chrono::seconds(10)));

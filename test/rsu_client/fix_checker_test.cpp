@@ -12,8 +12,72 @@ namespace {
 
 constexpr Stamp kNow = 1'700'000'000'000'000'000LL;
 
+// A setup with one connected vehicle: unaddressed fixes taken (the addressing has tests of its own).
 FixChecker checker() {
-  return FixChecker(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n", "test"));
+  FixCheckConfig config;
+  config.accept_unaddressed = true;
+  return FixChecker(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n", "test"), config);
+}
+
+FixChecker checkerOfStation(std::optional<std::uint32_t> station) {
+  FixCheckConfig config;
+  config.station_id = station;
+  return FixChecker(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n", "test"), config);
+}
+
+RsuFix fixFor(std::optional<std::uint32_t> station, Stamp stamp, double x) {
+  RsuFix fix{stamp, "rsu_a", x, 0.0, std::nullopt, std::nullopt};
+  fix.station_id = station;
+  return fix;
+}
+
+TEST(FixChecker, OnlyFixesAddressedToThisVehiclesStationIdPass) {
+  FixChecker c = checkerOfStation(1001);
+  EXPECT_TRUE(c.check(fixFor(1001u, kNow - 1000, 101), kNow).accepted());
+  const FixVerdict other = c.check(fixFor(1002u, kNow - 2000, 104), kNow);
+  EXPECT_EQ(other.rejection, FixRejection::kAddressedToAnother) << other.detail;
+  EXPECT_NE(other.detail.find("1002"), std::string::npos) << other.detail;
+  EXPECT_NE(other.detail.find("1001"), std::string::npos) << other.detail;
+  const FixVerdict unaddressed = c.check(fixFor(std::nullopt, kNow - 3000, 101), kNow);
+  EXPECT_EQ(unaddressed.rejection, FixRejection::kUnaddressed) << unaddressed.detail;
+  EXPECT_NE(unaddressed.detail.find("accept_unaddressed"), std::string::npos) << unaddressed.detail;
+  const FixCounters& k = c.counters().at("rsu_a");
+  EXPECT_EQ(k.received, 3u);
+  EXPECT_EQ(k.passed_checks, 1u);
+  EXPECT_EQ(k.addressed_to_another, 1u);
+  EXPECT_EQ(k.unaddressed, 1u);
+}
+
+TEST(FixChecker, AVehicleWithoutAStationIdTakesNoAddressedFix) {
+  FixChecker c = checkerOfStation(std::nullopt);
+  const FixVerdict v = c.check(fixFor(7u, kNow - 1000, 101), kNow);
+  EXPECT_EQ(v.rejection, FixRejection::kAddressedToAnother);
+  EXPECT_NE(v.detail.find("rsu.station_id"), std::string::npos) << v.detail;
+}
+
+TEST(FixChecker, TwoVehiclesFixesFromOneFrameAreNotDuplicatesOfEachOther) {
+  FixChecker c = checkerOfStation(1001);
+  FixCheckConfig both;
+  EXPECT_TRUE(c.check(fixFor(1001u, kNow - 1000, 101), kNow).accepted());
+  EXPECT_EQ(c.check(fixFor(1002u, kNow - 1000, 104), kNow).rejection, FixRejection::kAddressedToAnother);
+  EXPECT_EQ(c.check(fixFor(1001u, kNow - 1000, 101), kNow).rejection, FixRejection::kDuplicate);
+}
+
+TEST(FixChecker, AnAddressNotAStationIdIsRefusedAsBadAddress) {
+  FixChecker c = checkerOfStation(1001);
+  for (const char* child : {"", "base_link", "-5", "4294967296", "10 01", "0x3e9"}) {
+    RsuFix fix = fixFor(parseStationId(child), kNow - 1000, 101);
+    SentFields sent;
+    sent.frame_id = "map";
+    sent.covariance.diagonal() << 0.01486, 0.01486, kInfinity, kInfinity, kInfinity, kInfinity;
+    sent.child_frame_id = child;
+    fix.sent = sent;
+    const FixVerdict v = c.check(fix, kNow);
+    EXPECT_EQ(v.rejection, FixRejection::kBadAddress) << "'" << child << "': " << v.detail;
+  }
+  EXPECT_EQ(parseStationId("1001"), 1001u);
+  EXPECT_EQ(parseStationId("4294967295"), 4294967295u);
+  EXPECT_EQ(c.counters().at("rsu_a").bad_address, 6u);
 }
 
 TEST(FixChecker, ValidFixBecomesATwoDimensionalMeasurementWithInfiniteElsewhere) {
@@ -24,7 +88,7 @@ TEST(FixChecker, ValidFixBecomesATwoDimensionalMeasurementWithInfiniteElsewhere)
   EXPECT_EQ(v.measurement.covariance(0, 0), 0.01486);
   EXPECT_EQ(v.measurement.covariance(1, 1), 0.01486);
   for (int i = 2; i < 6; ++i) EXPECT_EQ(v.measurement.covariance(i, i), kInfinity);
-  EXPECT_EQ(c.counters().at("rsu_a").accepted, 1u);
+  EXPECT_EQ(c.counters().at("rsu_a").passed_checks, 1u);
 }
 
 TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
@@ -57,7 +121,7 @@ TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
   EXPECT_EQ(a.stale, 1u);
   EXPECT_EQ(a.from_future, 1u);
   EXPECT_EQ(a.duplicate, 1u);
-  EXPECT_EQ(a.accepted, 1u);
+  EXPECT_EQ(a.passed_checks, 1u);
   EXPECT_EQ(c.counters().at("rsu_z").unknown_rsu, 1u);
 }
 
@@ -110,13 +174,16 @@ TEST(FixChecker, AMessagesFrameCovarianceAndStampFieldAreHeldAgainstTheRegistry)
   EXPECT_EQ(a.wrong_frame, 4u);
   EXPECT_EQ(a.bad_stamp, 1u);
   EXPECT_EQ(a.bad_covariance, 8u);
-  EXPECT_EQ(a.accepted, 1u);
+  EXPECT_EQ(a.passed_checks, 1u);
   EXPECT_EQ(a.received, 1u + cases.size());
 }
 
 TEST(FixChecker, ARegistryFrameOtherThanMapAndACalibratedVarianceAreHonoured) {
+  FixCheckConfig one_vehicle;
+  one_vehicle.accept_unaddressed = true;
   FixChecker c(RsuRegistry::parse("map_frame: earth\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n",
-                                  "test"));
+                                  "test"),
+               one_vehicle);
   RsuFix fix = sentFix(kNow - 1000, 101);
   EXPECT_EQ(c.check(fix, kNow).rejection, FixRejection::kWrongFrame);
   fix.sent->frame_id = "earth";
@@ -181,8 +248,10 @@ TEST(FixChecker, ACalibratedRsusFixesAreCorrectedForItsSurveyAndClock) {
   const Eigen::Vector2d truth(20.0, -1.0), rsu_true(30.0, -7.0), rsu_surveyed(30.15, -7.05);
   const Eigen::Vector2d reported = rsu_surveyed + Eigen::Rotation2Dd(0.5 * M_PI / 180.0) * (truth - rsu_true);
   const Stamp t = 1'700'000'000'000'000'000LL;
-  FixChecker checker(registry);
-  const FixVerdict v = checker.check({t + 20'000'000, "a", reported.x(), reported.y(), std::nullopt, std::nullopt}, t + 60'000'000);
+  FixCheckConfig checks;
+  checks.station_id = 5;
+  FixChecker checker(registry, checks);
+  const FixVerdict v = checker.check({t + 20'000'000, "a", reported.x(), reported.y(), std::nullopt, std::nullopt, 5u}, t + 60'000'000);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_NEAR(v.measurement.pose.position.x(), truth.x(), 1e-9);
   EXPECT_NEAR(v.measurement.pose.position.y(), truth.y(), 1e-9);

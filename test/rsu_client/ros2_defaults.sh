@@ -31,7 +31,7 @@ fi
 
 exchange() {  # NAME: a listener with defaults, the Cyclone node publishing 10 fixes
   local name=$1
-  bounded 60 "$work/listen_$name.txt" "$coloc" rsu-listen --registry "$registry" --timeout 45 --idle-exit 3 &
+  bounded 60 "$work/listen_$name.txt" "$coloc" rsu-listen --registry "$registry" --accept-unaddressed --timeout 45 --idle-exit 3 &
   local listener=$!
   bounded 40 "$work/cyclone_$name.txt" "$publisher" rsu_a 10 95 -3 0.01486 30
   wait "$listener"

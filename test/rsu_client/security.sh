@@ -17,16 +17,16 @@ export ROS_LOCALHOST_ONLY=1
 printf '0.0,999,0\n0.1,999,0\n0.2,999,0\n0.3,999,0\n' > "$work/intruder.csv"
 
 # The listener stops 8 s after the RSU's last fix (the intruders have tried by then), or after 60 s.
-bounded 80 "$work/listen.txt" "$coloc" rsu-listen --registry "$registry" --reliable --security "$work/sec" --name vehicle \
+bounded 80 "$work/listen.txt" "$coloc" rsu-listen --registry "$registry" --station-id 7 --reliable --security "$work/sec" --name vehicle \
   --timeout 60 --idle-exit 8 &
 listener=$!
-bounded 30 "$work/rsu.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --generate 6 --rate 10 --security "$work/sec"
+bounded 30 "$work/rsu.txt" "$coloc" rsu-publish --registry "$registry" --station-id 7 --reliable --rsu rsu_a --generate 6 --rate 10 --security "$work/sec"
 # The rogue intruder sends without waiting for a match (it will never get one).
-bounded 20 "$work/rogue.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name intruder_rogue \
+bounded 20 "$work/rogue.txt" "$coloc" rsu-publish --registry "$registry" --station-id 7 --reliable --rsu rsu_a --name intruder_rogue \
   --security "$work/sec/rogue" --from "$work/intruder.csv" --wait-subscribers 0 || true
-bounded 20 "$work/listed.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name intruder_listed \
+bounded 20 "$work/listed.txt" "$coloc" rsu-publish --registry "$registry" --station-id 7 --reliable --rsu rsu_a --name intruder_listed \
   --security "$work/sec" --from "$work/intruder.csv" --wait-subscribers 0 || true
-bounded 20 "$work/plain.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --name plain \
+bounded 20 "$work/plain.txt" "$coloc" rsu-publish --registry "$registry" --station-id 7 --reliable --rsu rsu_a --name plain \
   --from "$work/intruder.csv" --wait-subscribers 0 || true
 wait "$listener"
 for f in rsu rogue listed plain listen; do echo "== $f"; grep -v 'SECURITY\|DATA_WRITER\|Function' "$work/$f.txt" || true; done

@@ -15,11 +15,11 @@ printf '0.00,95,-3\n0.05,96,-3\n0.10,500,500\n' > "$work/extra.csv"
 
 # The listener stops 4 s after the last fix (both publishers have sent by then), or after 60 s.
 # Reliable QoS: the losses counted here must be the emulated link's, not best effort's.
-bounded 80 "$work/listen.txt" "$coloc" rsu-listen --registry "$registry" --reliable --timeout 60 --idle-exit 4 --dimensions 7 4.8 1.9 &
+bounded 80 "$work/listen.txt" "$coloc" rsu-listen --registry "$registry" --station-id 7 --reliable --timeout 60 --idle-exit 4 --dimensions 7 4.8 1.9 &
 listener=$!
-bounded 30 "$work/publish.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --generate 20 --rate 20 --loss 0.25 \
+bounded 30 "$work/publish.txt" "$coloc" rsu-publish --registry "$registry" --station-id 7 --reliable --rsu rsu_a --generate 20 --rate 20 --loss 0.25 \
   --seed 3 --dimensions
-bounded 30 "$work/publish2.txt" "$coloc" rsu-publish --registry "$registry" --reliable --rsu rsu_a --from "$work/extra.csv"
+bounded 30 "$work/publish2.txt" "$coloc" rsu-publish --registry "$registry" --station-id 7 --reliable --rsu rsu_a --from "$work/extra.csv"
 wait "$listener"
 cat "$work/publish.txt" "$work/publish2.txt" "$work/listen.txt"
 

@@ -27,7 +27,7 @@ expected_samples=$(echo "$row" | cut -d, -f12)
 counters=$(grep -E '^ +/rsu/rsu_a_vlp32c/fix +[0-9]' "$work/fuse.txt")
 applied=$(echo "$counters" | awk '{print $3}')
 gated=$(echo "$counters" | awk '{print $4}')
-lost=$(grep -E 'rsu_a_vlp32c/fix .* lost on the emulated link' "$work/fuse.txt" | sed -E 's/.* ([0-9]+) lost on the emulated link.*/\1/')
+lost=$(grep -E 'rsu_a_vlp32c/addressed_fix .* lost on the emulated link' "$work/fuse.txt" | sed -E 's/.* ([0-9]+) lost on the emulated link.*/\1/')
 # The fused error within 50 m of the RSU (30, -7), from coloc fuse's error.csv.
 read -r samples mean < <(awk -F, 'NR > 1 { dx = $4 - 30; dy = $5 + 7; if (dx * dx + dy * dy <= 2500) { n++; s += $6 } }
                                  END { printf "%d %.9f\n", n, s / n }' "$work/fuse/error.csv")

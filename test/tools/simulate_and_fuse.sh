@@ -12,8 +12,9 @@ trap 'rm -rf "$work"' EXIT
 cmp "$work/a/log/log_0.db3" "$work/b/log/log_0.db3" || { echo "FAIL: the same seed gave different logs"; exit 1; }
 cmp "$work/a/rsu_fixes.csv" "$work/b/rsu_fixes.csv" >/dev/null 2>&1 || true  # processing times are measured, not simulated
 "$coloc" fuse "$work/a/log" --map "$work/a/map" --config "$work/a/fuse.yaml" --out "$work/fused" | tee "$work/fuse.txt"
-grep -q '/rsu/rsu_a/fix .* rsu_fix' "$work/fuse.txt" || { echo "FAIL: no RSU fixes in the log"; exit 1; }
-grep -q 'RSU rsu_a: [1-9][0-9]* fixes received, [1-9][0-9]* accepted' "$work/fuse.txt" || { echo "FAIL: the fixes did not pass the registry's checks"; exit 1; }
+grep -q '/rsu/rsu_a/addressed_fix .* rsu_fix' "$work/fuse.txt" || { echo "FAIL: no addressed RSU fixes in the log"; exit 1; }
+grep -q 'RSU rsu_a: [1-9][0-9]* fixes received; refused by the checks: .*; passed [1-9][0-9]*; the filter applied [1-9]' "$work/fuse.txt" ||
+  { echo "FAIL: the fixes did not pass the registry's checks and reach the filter"; exit 1; }
 grep -q 'NDT: [0-9]* scans -> [1-9]' "$work/fuse.txt" || { echo "FAIL: NDT produced no pose"; exit 1; }
 grep -q 'position error vs ground truth' "$work/fuse.txt" || { echo "FAIL: no error against ground truth"; exit 1; }
 mean=$(sed -n '/position error vs ground truth/ s/.*mean \([0-9.]*\) m, RMSE.*/\1/p' "$work/fuse.txt")

@@ -82,9 +82,9 @@ TEST(TwinRecording, AnRsusPerfectTwinSendsWhatTheSameRsuPerfectlySurveyedAndSync
   options.perfect_rsus = false;
   const TwinRecordingSummary perfect = recordTwin(exact, options);
   const std::string id = exact.rsus[0].id;
-  const auto twin = onTopic(*with_twin.log, rsu_client::fixTopic(perfectRsuId(id)));
-  const auto own = onTopic(*with_twin.log, rsu_client::fixTopic(id));
-  const auto expected = onTopic(*perfect.log, rsu_client::fixTopic(id));
+  const auto twin = onTopic(*with_twin.log, rsu_client::addressedFixTopic(perfectRsuId(id)));
+  const auto own = onTopic(*with_twin.log, rsu_client::addressedFixTopic(id));
+  const auto expected = onTopic(*perfect.log, rsu_client::addressedFixTopic(id));
   ASSERT_GT(expected.size(), 20u);
   ASSERT_EQ(twin.size(), expected.size());
   ASSERT_EQ(own.size(), expected.size());
@@ -92,10 +92,11 @@ TEST(TwinRecording, AnRsusPerfectTwinSendsWhatTheSameRsuPerfectlySurveyedAndSync
     EXPECT_EQ(twin[i]->log_time, expected[i]->log_time) << "fix " << i;
     EXPECT_EQ(twin[i]->data, expected[i]->data) << "fix " << i;  // the same position and stamp, to the bit
     // The RSU's own fix is where its survey says, 10 ms later on its clock.
-    const io::StampedPose a = std::get<io::StampedPose>(io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, own[i]->data));
-    const io::StampedPose b = std::get<io::StampedPose>(io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, twin[i]->data));
+    const io::Odometry a = std::get<io::Odometry>(io::decodeMessage(io::MessageKind::kOdometry, own[i]->data));
+    const io::Odometry b = std::get<io::Odometry>(io::decodeMessage(io::MessageKind::kOdometry, twin[i]->data));
+    EXPECT_EQ(a.child_frame_id, std::to_string(off.vehicle_station_id));  // addressed to the ego
     EXPECT_NEAR(a.header.stamp - b.header.stamp, 10'000'000, 1);
-    const double shift = (a.measurement.pose.position - b.measurement.pose.position).head<2>().norm();
+    const double shift = (a.pose.pose.position - b.pose.pose.position).head<2>().norm();
     EXPECT_GT(shift, 0.10) << "fix " << i;
     EXPECT_LT(shift, 0.18 + 0.5 * M_PI / 180.0 * 60.0) << "fix " << i;  // 18 cm and 0.5 deg at up to 60 m
   }
@@ -131,7 +132,7 @@ TEST(TwinRecording, TheOracleLimitWithholdsExactlyTheFixesFartherThanItFromTheTr
   options.oracle_fix_limit = limit;
   const TwinRecordingSummary bounded = recordTwin(scenario, options);
 
-  const auto sent = onTopic(*all.log, rsu_client::fixTopic(id)), kept = onTopic(*bounded.log, rsu_client::fixTopic(id));
+  const auto sent = onTopic(*all.log, rsu_client::addressedFixTopic(id)), kept = onTopic(*bounded.log, rsu_client::addressedFixTopic(id));
   ASSERT_EQ(sent.size(), errors.size());  // no link loss: every fix is on the log
   std::size_t k = 0, beyond = 0;
   for (std::size_t i = 0; i < sent.size(); ++i) {

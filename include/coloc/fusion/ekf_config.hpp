@@ -61,6 +61,20 @@ struct EkfConfig {
 
   /// A pose measurement that measures x, y and yaw initialises the filter when none has been given.
   bool auto_initialize = true;
+
+  // Integrity (coloc's; Autoware's EKF has none): when the filter's estimate cannot be believed.
+  // An anchor is a pose source independent of the vehicle's own map matching (a roadside fix, GNSS).
+  /// Anchor poses gated in a row, each within integrity_anchor_agreement of the previous one's
+  /// disagreement, that make the filter `lost` (one makes it `degraded`). 0 = never lost by anchors.
+  int integrity_lost_after_gated_anchors = 2;
+  double integrity_anchor_agreement = 1.0;  ///< m
+  /// Poses of any other source gated in a row that make the filter `degraded`. 0 = off.
+  int integrity_degraded_after_gated = 5;
+  /// Seconds without any pose applied (dead reckoning on the twist alone) that make it `degraded`. 0 = off.
+  double integrity_dead_reckoning_limit = 3.0;  ///< s
+  /// Seconds of other poses applied, with no anchor disagreeing again, after which a single anchor's
+  /// disagreement (an outlier fix) no longer counts.
+  double integrity_anchor_memory = 2.0;  ///< s
 };
 
 }  // namespace coloc::fusion

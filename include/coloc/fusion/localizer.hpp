@@ -13,6 +13,7 @@
 
 #include "coloc/core/types.hpp"
 #include "coloc/fusion/ekf_config.hpp"
+#include "coloc/fusion/integrity.hpp"
 #include "coloc/fusion/verdict.hpp"
 
 namespace coloc::fusion {
@@ -32,6 +33,9 @@ struct Estimate {
   double yaw_bias = 0.0;
   Vector6d state = Vector6d::Zero();  ///< raw EKF state [x, y, yaw, yaw_bias, vx, wz]
   Matrix6d state_covariance = Matrix6d::Zero();
+  /// Whether to believe it (see integrity.hpp); degraded or lost, pose_covariance includes the
+  /// disagreement that made it so (state_covariance is the filter's own).
+  LocalizationState localization = LocalizationState::kInitialising;
 };
 
 struct SourceReport {
@@ -51,13 +55,20 @@ class Localizer {
   /// Registers a named input. Names are unique across kinds; registering a name twice returns its id.
   /// `smoothing_steps`: ticks over which each of the source's poses is applied (0: the configuration's
   /// pose_smoothing_steps); a source registered again keeps what it was registered with first.
-  SourceId addPoseSource(const std::string& name, int smoothing_steps = 0);
+  /// `anchor`: a position independent of the vehicle's own map matching (a roadside fix, GNSS), whose
+  /// sustained disagreement means the filter, not the source, is wrong (integrity.hpp).
+  SourceId addPoseSource(const std::string& name, int smoothing_steps = 0, bool anchor = false);
   SourceId addTwistSource(const std::string& name);
   std::optional<SourceId> findSource(std::string_view name) const;
 
   /// Starts (or restarts) the filter at a pose; x, y and yaw must be measured.
   Verdict initialize(const PoseMeasurement& pose);
   bool initialized() const;
+  /// Back to before the first initial pose (a clock that went back): the estimate, the history and
+  /// every waiting measurement go; sources and counters stay.
+  void reset();
+  /// The filter's state and its reason, as the estimate carries it.
+  const IntegrityStatus& integrity() const;
 
   Verdict feedPose(SourceId source, const PoseMeasurement& measurement);
   Verdict feedPose(std::string_view source, const PoseMeasurement& measurement);

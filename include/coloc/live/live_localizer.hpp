@@ -4,6 +4,7 @@
 // thread, and publishes the fused pose (PoseWithCovarianceStamped) and odometry at every filter tick.
 // A ROS 2 system on the same DDS domain sees it as a node.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -26,6 +27,8 @@ struct LiveOptions {
   /// Run on the time received on /clock (rosgraph_msgs/Clock), as ROS 2 nodes with use_sim_time do
   /// when a recorded log is played; off: the system clock.
   bool use_sim_time = false;
+  /// Starts, recoveries, state changes and clock resets, one line each, on the pipeline's thread.
+  std::function<void(const std::string& line)> on_event;
 };
 
 /// What one subscribed topic brought.

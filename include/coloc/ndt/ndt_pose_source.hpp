@@ -1,7 +1,9 @@
 #pragma once
 // NDT as a pose source for the filter, without ROS: a scan and the filter's prediction for its stamp
 // in, a vehicle pose with covariance (or the reason there is none) out.
+#include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "coloc/core/types.hpp"
@@ -32,7 +34,16 @@ struct NdtPoseSourceCounters {
   std::uint64_t max_iterations = 0;
   std::uint64_t oscillation = 0;
   std::uint64_t low_score = 0;
+  std::uint64_t heading_searches = 0;  ///< scans matched from many headings (searchHeading)
   double align_ms_total = 0.0;
+};
+
+/// How searchHeading tries headings.
+struct HeadingSearch {
+  int candidates = 16;            ///< evenly spread around the circle
+  std::optional<double> near;     ///< rad; only candidates within `within` of it (the direction of travel)
+  double within = M_PI / 2;       ///< rad
+  double vx = 0.0;                ///< m/s, for deskewing
 };
 
 struct ScanOutcome {
@@ -59,6 +70,11 @@ class NdtPoseSource {
   /// The same for a scan shared with other sources (replays of one log): with an AlignmentMemo, asked of it.
   ScanOutcome process(const std::shared_ptr<const PointCloud>& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
 
+  /// A vehicle at `position` (map x, y; the height is the map's ground there) with an unknown heading:
+  /// the scan matched from every candidate heading, the accepted match with the best NVTL kept (one
+  /// scan in the counters). Never throws for bad scans: the outcome says what happened.
+  ScanOutcome searchHeading(const PointCloud& scan, Stamp stamp, const Eigen::Vector2d& position, const HeadingSearch& search);
+
   const NdtPoseSourceCounters& counters() const { return counters_; }
   const DynamicMap& map() const { return map_; }
 
@@ -67,6 +83,8 @@ class NdtPoseSource {
   ScanOutcome process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& predicted, double vx, double wz);
   ScanOutcome match(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz, const NdtTarget& target) const;
   void count(const ScanOutcome& out);
+  /// The vehicle's pose from an accepted alignment of the LiDAR: map_T_base = map_T_lidar * lidar_T_base.
+  void producePose(ScanOutcome& out, Stamp stamp) const;
 
   NdtPoseSourceConfig config_;
   DynamicMap map_;

@@ -38,5 +38,10 @@ PoseMeasurement poseFromMessage(const io::RosMessage& message, const InputConfig
 /// A roadside fix as an RSU sends it (PoseWithCovarianceStamped on /rsu/<id>/fix): its stamp, x and
 /// y, and its yaw only if the sender gave the yaw a finite variance.
 rsu_client::RsuFix fixFromMessage(const io::StampedPose& message, const std::string& rsu_id);
+/// A fix addressed to one vehicle (nav_msgs/msg/Odometry on /rsu/<id>/addressed_fix): the same, and the
+/// station id its child_frame_id names (kept as sent for the checks).
+rsu_client::RsuFix fixFromMessage(const io::Odometry& message, const std::string& rsu_id);
+/// Either of the two, by the decoded message's type; throws coloc::Error for another type.
+rsu_client::RsuFix fixFromMessage(const io::RosMessage& message, const std::string& rsu_id);
 
 }  // namespace coloc::pipeline

@@ -55,7 +55,22 @@ struct PipelineReport {
   std::uint64_t scans_without_guess = 0;     ///< before the filter could predict their pose
   std::uint64_t scans_without_map = 0;       ///< no map given
   std::uint64_t scans_superseded = 0;        ///< live: replaced by a newer scan while NDT was busy
-  std::map<std::string, rsu_client::FixCounters> fixes;  ///< per RSU id
+  std::map<std::string, rsu_client::FixCounters> fixes;  ///< per RSU id: received, refused by the checks, passed
+  /// Per RSU id, what the filter made of the fixes that passed the checks: applied, gated, not
+  /// initialised (before the filter started), too old, ...
+  std::map<std::string, fusion::SourceCounters> filter_of_fixes;
+  /// Whether to believe the estimate (integrity.hpp), and why; while initialising, what it waits for.
+  fusion::LocalizationState state = fusion::LocalizationState::kInitialising;
+  std::string state_reason;
+  std::string started_how;                   ///< how the filter last started ("initial pose", "position from ..., heading ...")
+  std::uint64_t starts = 0;                  ///< starts without a loss before (initial poses, starts from the sources)
+  std::uint64_t recoveries = 0;              ///< restarts of a lost filter from the sources that agree
+  std::vector<std::string> recovery_reasons; ///< the first few
+  std::uint64_t degradations = 0, losses = 0;
+  std::uint64_t clock_resets = 0;            ///< the clock went back and the filter started again
+  std::uint64_t inputs_dropped_by_reset = 0; ///< inputs that arrived before a jump back, dropped by it
+  std::uint64_t events = 0;                  ///< starts, recoveries, state changes, clock resets
+  std::vector<std::string> first_events;     ///< the first few, as one line each
   double speed_scale = 1.0;                  ///< true speed per odometry speed, as learned from NDT (1 until known)
   double speed_scale_distance = 0.0;         ///< m of travel compared so far
   double yaw_rate_bias = 0.0;                ///< rad/s, odometry minus true yaw rate, as learned from NDT (0 until known)
@@ -109,6 +124,8 @@ class Pipeline {
   void onTwistInput(std::function<void(const std::string& source, const TwistMeasurement& handed, const TwistMeasurement& received)> callback);
   /// Every rejection, as one line naming the input and the reason.
   void onRejection(std::function<void(const std::string& line)> callback);
+  /// Starts, recoveries, changes of the localization state and clock resets, one line each.
+  void onEvent(std::function<void(const std::string& line)> callback);
 
   /// Offline: processes every input that arrived by `now` in arrival order (ties in push order),
   /// running the filter's ticks up to each input's arrival, then up to `now`.

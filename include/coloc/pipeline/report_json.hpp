@@ -7,6 +7,7 @@
 
 #include "coloc/fusion/localizer.hpp"
 #include "coloc/ndt/ndt_pose_source.hpp"
+#include "coloc/pipeline/pipeline.hpp"
 #include "coloc/rsu_client/rsu_fix.hpp"
 
 namespace coloc::pipeline {
@@ -15,7 +16,10 @@ namespace coloc::pipeline {
 std::string sourcesJson(const std::vector<fusion::SourceReport>& sources);
 /// {scans, poses, scans_without_guess, no_map, ..., map_builds, tiles_in_target}
 std::string ndtJson(const ndt::NdtPoseSourceCounters& ndt, const ndt::DynamicMapStats& map, std::uint64_t scans_without_guess);
-/// {RSU_ID: {received, accepted, unknown_rsu, ...}, ...}
-std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes);
+/// {RSU_ID: {received, passed_checks, refused_by_checks: {unknown_rsu, ...}, applied, gated,
+/// not_initialized, too_old, ...}, ...}: "applied" is what the filter applied, nothing else.
+std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes, const std::map<std::string, fusion::SourceCounters>& filter);
+/// {state, reason, started_how, starts, recoveries, ..., events}
+std::string localizationJson(const PipelineReport& report);
 
 }  // namespace coloc::pipeline

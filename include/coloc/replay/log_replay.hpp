@@ -34,6 +34,13 @@ struct ReplayResult {
   std::vector<fusion::SourceReport> sources;
   std::uint64_t unknown_source_inputs = 0;
   std::vector<io::TrajectoryPoint> fused;          ///< the estimate at every tick
+  /// Beside fused: the standard deviations of x and y the estimate reported (its covariance as given
+  /// out, the integrity's inflation included) and its localization state.
+  std::vector<Eigen::Vector2d> fused_sd;
+  std::vector<fusion::LocalizationState> fused_localization;
+  /// The pipeline's report at the end: the localization state, how it started, recoveries, clock
+  /// resets, and what the filter made of the fixes that passed the checks.
+  pipeline::PipelineReport pipeline_report;
   std::vector<io::TrajectoryPoint> pose_inputs;    ///< every pose measurement fed (NDT, fixes, others), for plots
   std::vector<std::string> pose_input_sources;     ///< the source of each pose input
   std::vector<Eigen::Matrix2d> pose_input_covariances;  ///< the x/y covariance each pose input claimed (map frame)
@@ -83,7 +90,8 @@ struct ReplayResult {
   /// Everything that follows from the log and the config, as JSON (summary.json of `coloc fuse`): the
   /// same log and config give the same bytes. `log` is the name to print for the recording.
   std::string summaryJson(const std::string& log) const;
-  /// error.csv: the planar error at every tick with ground truth, split along and across the heading.
+  /// error.csv: the planar error at every tick with ground truth, split along and across the heading,
+  /// with the standard deviations of x and y the filter reported then and its localization state.
   void writeErrorCsv(const std::string& path) const;
   /// input_error.csv: every pose input's error against ground truth at its stamp, by source.
   void writeInputErrorCsv(const std::string& path) const;

@@ -47,8 +47,12 @@ struct DdsConfig {
 /// variable and its value when it is malformed.
 DdsConfig ddsConfigFromRosEnvironment();
 
-/// The ROS topic a fix of this RSU travels on; DDS adds the "rt" prefix.
+/// The ROS topic an unaddressed fix of this RSU travels on (geometry_msgs/msg/PoseWithCovarianceStamped);
+/// DDS adds the "rt" prefix. A vehicle refuses these unless rsu.accept_unaddressed says otherwise.
 std::string fixTopic(const std::string& rsu_id);
+/// The ROS topic of this RSU's fixes addressed to one vehicle each (nav_msgs/msg/Odometry, the
+/// vehicle's station id in decimal as child_frame_id): see README, "The RSU fix protocol".
+std::string addressedFixTopic(const std::string& rsu_id);
 inline constexpr const char* kVehicleDimensionsTopic = "/vehicle/dimensions";
 
 struct VehicleDimensions {
@@ -72,7 +76,7 @@ class FixSubscriber {
  public:
   /// Called on a DDS thread for every sample: the fix and its arrival time (systemNow()).
   using Callback = std::function<void(const RsuFix& fix, Stamp received)>;
-  /// Subscribes to the fix topic of each RSU id. Throws coloc::Error if DDS refuses (bad security
+  /// Subscribes to both fix topics (addressed and unaddressed) of each RSU id. Throws coloc::Error if DDS refuses (bad security
   /// files, ...), naming the reason.
   /// `on_refused` (optional) is called on a DDS thread with one line naming the topic and the reason
   /// for every sample refused before decoding (wrong encapsulation, undecodable).
@@ -91,9 +95,13 @@ class FixSubscriber {
 
 class FixPublisher {
  public:
-  FixPublisher(const DdsConfig& config, const std::string& rsu_id);
+  /// `addressed`: fixes go to one vehicle each (addressedFixTopic; every fix must carry its station
+  /// id); otherwise the unaddressed topic of a setup with one connected vehicle.
+  FixPublisher(const DdsConfig& config, const std::string& rsu_id, bool addressed = true);
   ~FixPublisher();
-  /// Publishes with frame "map", the fix's x and y, its variance on x and y and +inf elsewhere.
+  /// Publishes with frame "map", the fix's x and y, its variance on x and y and +inf elsewhere (and,
+  /// addressed, the station id as child_frame_id). Throws coloc::Error for an addressed publisher
+  /// given a fix without a station id.
   void publish(const RsuFix& fix, double variance);
   /// Waits until at least `count` readers are matched; false on timeout.
   bool waitForSubscribers(int count, std::chrono::milliseconds timeout);

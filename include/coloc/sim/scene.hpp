@@ -48,6 +48,8 @@ struct Scenario {
   std::string vehicle_lidar = "VLP-32C";
   double vehicle_lidar_height = 1.9;  ///< m above the road
   OdometryNoise odometry;             ///< the wheel odometry's noise, scale error and yaw-rate bias
+  /// The ego's station id, as its CAM carries it: the RSUs address its fixes to it.
+  std::uint32_t vehicle_station_id = 1001;
   std::vector<ScenarioRsu> rsus;
   std::vector<TrafficVehicle> traffic;
   ErrorSources errors;  ///< realistic by default

@@ -8,6 +8,8 @@
 #include <functional>
 #include <map>
 #include <string>
+
+#include "coloc/io/ros_messages.hpp"
 #include <vector>
 
 #include "coloc/core/time.hpp"
@@ -63,6 +65,10 @@ struct TwinRecordingOptions {
 
 /// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.
 std::string perfectRsuId(const std::string& id);
+
+/// A roadside fix as an RSU sends it under the protocol (README, "The RSU fix protocol"): addressed to
+/// the vehicle of `station_id`, the RSU's variance on x and y, not measured elsewhere.
+io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, double variance, std::uint32_t station_id);
 
 /// One RSU frame within coverage: what the perception made of it.
 struct RsuFrameRecord {

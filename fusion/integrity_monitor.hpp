@@ -1,0 +1,47 @@
+#pragma once
+// The filter's integrity from what its sources say at each pose's first use (applied or gated, and by
+// how much), and from how long it has gone on the twist alone. The Localizer feeds it; see
+// coloc/fusion/integrity.hpp for the states.
+#include <string>
+#include <unordered_map>
+
+#include "coloc/core/types.hpp"
+#include "coloc/fusion/ekf_config.hpp"
+#include "coloc/fusion/integrity.hpp"
+
+namespace coloc::fusion {
+
+class IntegrityMonitor {
+ public:
+  explicit IntegrityMonitor(const EkfConfig& config);
+
+  /// The filter (re)started at `stamp` (localized), or was reset (initialising).
+  void restart(Stamp stamp, bool initialized);
+  /// A pose's first use. `innovation`: measured minus predicted x and y (NaN where not measured).
+  void onPose(const std::string& source, bool anchor, bool applied, const Eigen::Vector2d& innovation, double d2, Stamp now);
+  /// The filter's clock advanced to `now`.
+  void onTick(Stamp now);
+
+  const IntegrityStatus& status() const { return status_; }
+  /// What the reported x/y covariance must add to cover the anchors' disagreement (zero when localized).
+  const Eigen::Matrix2d& inflation() const { return inflation_; }
+
+ private:
+  enum class Cause { kNone, kAnchor, kGated, kDeadReckoning };
+  void enter(LocalizationState state, Cause cause, std::string reason, Stamp now);
+
+  EkfConfig config_;
+  IntegrityStatus status_;
+  Cause cause_ = Cause::kNone;
+  Eigen::Matrix2d inflation_ = Eigen::Matrix2d::Zero();
+  // Anchors: the gated run, and the disagreement it tells.
+  int anchor_gated_in_a_row_ = 0;
+  Eigen::Vector2d anchor_disagreement_ = Eigen::Vector2d::Zero();
+  Stamp anchor_gated_at_ = 0;
+  // Other sources: gated in a row, by name.
+  std::unordered_map<std::string, int> gated_in_a_row_;
+  std::string gated_source_;
+  Stamp last_applied_ = 0;
+};
+
+}  // namespace coloc::fusion

@@ -1,0 +1,119 @@
+// The filter's integrity: what makes it degraded or lost, what brings it back, and how its reported
+// covariance covers a disagreement it cannot yet resolve.
+#include <gtest/gtest.h>
+
+#include "coloc/fusion/localizer.hpp"
+#include "measurements.hpp"
+
+namespace coloc::fusion {
+namespace {
+
+using testing::fix2d;
+using testing::kStart;
+using testing::kTick;
+using testing::planarPose;
+using testing::twist;
+
+struct Drive {
+  Localizer filter;
+  SourceId odom, ndt, rsu;
+  Stamp now = kStart;
+  Drive() : odom(filter.addTwistSource("odom")), ndt(filter.addPoseSource("ndt")), rsu(filter.addPoseSource("/rsu/a/fix", 0, true)) {
+    filter.initialize(planarPose(kStart, 0.0, 0.0, 0.0, 0.0225, 0.0001));
+  }
+  // 0.1 s standing still: odometry every tick, a map-matching pose at `ndt_y` every 0.1 s.
+  void step(double ndt_y) {
+    for (int k = 0; k < 5; ++k) {
+      now += kTick;
+      filter.feedTwist(odom, twist(now, 0.0, 0.0));
+      filter.advanceTo(now);
+    }
+    filter.feedPose(ndt, planarPose(now, 0.0, ndt_y, 0.0));
+  }
+};
+
+TEST(Integrity, AFilterThatAgreesWithItsSourcesIsLocalized) {
+  Drive d;
+  for (int i = 0; i < 10; ++i) {
+    d.step(0.0);
+    d.filter.feedPose(d.rsu, fix2d(d.now, 0.01, -0.01, 0.0002));
+  }
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kLocalized);
+  EXPECT_EQ(d.filter.estimate()->localization, LocalizationState::kLocalized);
+}
+
+TEST(Integrity, OneAnchorFarOffDegradesAndTheReportedCovarianceCoversIt) {
+  Drive d;
+  d.step(0.0);
+  const double sd_before = std::sqrt(d.filter.estimate()->pose_covariance(1, 1));
+  const Verdict v = d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 5.0, 0.0002));
+  ASSERT_EQ(v.reason, Reason::kGated);
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kDegraded);
+  EXPECT_NE(d.filter.integrity().reason.find("/rsu/a/fix"), std::string::npos) << d.filter.integrity().reason;
+  const Estimate e = *d.filter.estimate();
+  // 5 m of disagreement: the reported deviation across is at least that, the filter's own is not.
+  EXPECT_LT(sd_before, 0.2);
+  EXPECT_GE(std::sqrt(e.pose_covariance(1, 1)), 5.0);
+  EXPECT_LT(std::sqrt(e.state_covariance(1, 1)), 0.2);
+}
+
+TEST(Integrity, AnchorsTellingTheSameStoryAgainMakeItLost) {
+  Drive d;
+  d.step(0.0);
+  d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 5.0, 0.0002));
+  d.step(0.0);  // the map matching keeps confirming the filter
+  d.filter.feedPose(d.rsu, fix2d(d.now, 0.02, 5.03, 0.0002));
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kLost);
+  EXPECT_EQ(d.filter.integrity().losses, 1u);
+  EXPECT_GE(std::sqrt(d.filter.estimate()->pose_covariance(1, 1)), 5.0);
+}
+
+TEST(Integrity, AnchorsThatDisagreeWithEachOtherAreOutliersNotALoss) {
+  Drive d;
+  d.step(0.0);
+  d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 5.0, 0.0002));
+  d.step(0.0);
+  d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, -4.0, 0.0002));  // a different story: 9 m from the first
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kDegraded);
+  // The other sources go on agreeing for longer than the anchor memory: the outliers no longer count.
+  for (int i = 0; i < 25; ++i) d.step(0.0);
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kLocalized);
+  EXPECT_LT(std::sqrt(d.filter.estimate()->pose_covariance(1, 1)), 0.2);
+}
+
+TEST(Integrity, AnAnchorAgreeingAgainEndsItsDisagreement) {
+  Drive d;
+  d.step(0.0);
+  d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 5.0, 0.0002));
+  ASSERT_EQ(d.filter.integrity().state, LocalizationState::kDegraded);
+  d.step(0.0);
+  EXPECT_EQ(d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 0.01, 0.0002)).outcome, Outcome::kApplied);
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kLocalized);
+}
+
+TEST(Integrity, DeadReckoningBeyondTheLimitDegradesUntilAPoseIsApplied) {
+  Drive d;
+  d.step(0.0);
+  for (int k = 0; k < 200; ++k) {  // 4 s of odometry alone
+    d.now += kTick;
+    d.filter.feedTwist(d.odom, twist(d.now, 0.0, 0.0));
+    d.filter.advanceTo(d.now);
+  }
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kDegraded);
+  EXPECT_NE(d.filter.integrity().reason.find("no pose applied"), std::string::npos) << d.filter.integrity().reason;
+  d.step(0.0);
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kLocalized);
+}
+
+TEST(Integrity, AResetFilterIsInitialisingWithNoEstimate) {
+  Drive d;
+  d.step(0.0);
+  d.filter.reset();
+  EXPECT_FALSE(d.filter.initialized());
+  EXPECT_FALSE(d.filter.estimate().has_value());
+  EXPECT_EQ(d.filter.integrity().state, LocalizationState::kInitialising);
+  EXPECT_EQ(d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 0.0, 0.0002)).reason, Reason::kNotInitialized);
+}
+
+}  // namespace
+}  // namespace coloc::fusion
