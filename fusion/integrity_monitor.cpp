@@ -27,7 +27,6 @@ void IntegrityMonitor::restart(Stamp stamp, bool initialized) {
   cause_ = Cause::kNone;
   inflation_.setZero();
   anchor_gated_in_a_row_ = 0;
-  gated_in_a_row_.clear();
   last_applied_ = stamp;
 }
 
@@ -43,7 +42,8 @@ void IntegrityMonitor::enter(LocalizationState state, Cause cause, std::string r
   if (state == LocalizationState::kLocalized) inflation_.setZero();
 }
 
-void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool applied, const Eigen::Vector2d& innovation, double d2, Stamp now) {
+void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool applied, const Eigen::Vector2d& innovation, double d2,
+                              int gated_in_a_row, Stamp now) {
   if (status_.state == LocalizationState::kInitialising) return;
   const bool planar = innovation.allFinite();
   if (anchor && planar) {
@@ -73,9 +73,7 @@ void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool appli
     if (applied) last_applied_ = now;
     return;
   }
-  int& in_a_row = gated_in_a_row_[source];
   if (applied) {
-    in_a_row = 0;
     last_applied_ = now;
     if (cause_ == Cause::kDeadReckoning || (cause_ == Cause::kGated && gated_source_ == source))
       enter(LocalizationState::kLocalized, Cause::kNone, {}, now);
@@ -87,12 +85,11 @@ void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool appli
     }
     return;
   }
-  ++in_a_row;
   const int limit = config_.integrity_degraded_after_gated;
-  if (limit > 0 && in_a_row >= limit && status_.state == LocalizationState::kLocalized) {
+  if (limit > 0 && gated_in_a_row >= limit && status_.state == LocalizationState::kLocalized) {
     std::ostringstream why;
     why.precision(3);
-    why << in_a_row << " poses of " << source << " in a row gated (squared Mahalanobis distance " << d2 << ")";
+    why << gated_in_a_row << " poses of " << source << " in a row gated (squared Mahalanobis distance " << d2 << ")";
     gated_source_ = source;
     enter(LocalizationState::kDegraded, Cause::kGated, why.str(), now);
   }

@@ -3,7 +3,6 @@
 // how much), and from how long it has gone on the twist alone. The Localizer feeds it; see
 // coloc/fusion/integrity.hpp for the states.
 #include <string>
-#include <unordered_map>
 
 #include "coloc/core/types.hpp"
 #include "coloc/fusion/ekf_config.hpp"
@@ -17,8 +16,10 @@ class IntegrityMonitor {
 
   /// The filter (re)started at `stamp` (localized), or was reset (initialising).
   void restart(Stamp stamp, bool initialized);
-  /// A pose's first use. `innovation`: measured minus predicted x and y (NaN where not measured).
-  void onPose(const std::string& source, bool anchor, bool applied, const Eigen::Vector2d& innovation, double d2, Stamp now);
+  /// A pose's first use. `innovation`: measured minus predicted x and y (NaN where not measured);
+  /// `gated_in_a_row`: the source's poses gated in a row, this one included (the Localizer keeps it).
+  void onPose(const std::string& source, bool anchor, bool applied, const Eigen::Vector2d& innovation, double d2, int gated_in_a_row,
+              Stamp now);
   /// The filter's clock advanced to `now`.
   void onTick(Stamp now);
 
@@ -38,9 +39,7 @@ class IntegrityMonitor {
   int anchor_gated_in_a_row_ = 0;
   Eigen::Vector2d anchor_disagreement_ = Eigen::Vector2d::Zero();
   Stamp anchor_gated_at_ = 0;
-  // Other sources: gated in a row, by name.
-  std::unordered_map<std::string, int> gated_in_a_row_;
-  std::string gated_source_;
+  std::string gated_source_;  ///< the other source whose gated run degraded the filter
   Stamp last_applied_ = 0;
 };
 

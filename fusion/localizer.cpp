@@ -198,7 +198,8 @@ struct Localizer::Impl {
                            src.gated_in_a_row >= config.pose_gate_recovery && std::isfinite(d2);
       if (!recover) {
         ++src.gated_in_a_row;
-        if (src.kind == SourceKind::kPose) integrity.onPose(src.name, src.anchor, false, planarInnovation(back, record), d2, clock);
+        if (src.kind == SourceKind::kPose)
+          integrity.onPose(src.name, src.anchor, false, planarInnovation(back, record), d2, src.gated_in_a_row, clock);
         Verdict v{Outcome::kRejected, Reason::kGated, inputKind(id), src.name, stamp, back, d2, why.str()};
         ++src.counters.gated;
         return report(std::move(v));
@@ -215,7 +216,7 @@ struct Localizer::Impl {
       src.gated_in_a_row = 0;
     }
     if (src.kind == SourceKind::kPose)
-      integrity.onPose(src.name, src.anchor, true, src.anchor ? planarInnovation(back, record) : Eigen::Vector2d::Zero(), d2, clock);
+      integrity.onPose(src.name, src.anchor, true, src.anchor ? planarInnovation(back, record) : Eigen::Vector2d::Zero(), d2, 0, clock);
     const int steps = smoothingSteps(src);
     // The tick must stay in the history for all uses; fewer, heavier uses carry the same information.
     const int uses = std::max(1, std::min(steps, 1 + config.history_steps - back));
@@ -269,6 +270,7 @@ struct Localizer::Impl {
     initialized = true;
     if (!clock_set || clock < stamp) clock = stamp;
     clock_set = true;
+    for (Source& s : sources) s.gated_in_a_row = 0;  // a run of gated poses was against the old start
     integrity.restart(stamp, true);
     // Waiting measurements older than the new start can never find their tick.
     std::vector<Pending> waiting;

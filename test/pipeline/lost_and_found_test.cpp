@@ -6,6 +6,7 @@
 
 #include "coloc/pipeline/pipeline.hpp"
 #include "measurements.hpp"
+#include "one_rsu.hpp"
 
 namespace coloc::pipeline {
 namespace {
@@ -18,15 +19,7 @@ using coloc::testing::twist;
 constexpr std::uint32_t kEgo = 1001, kOther = 1002;
 constexpr double kSpeed = 10.0, kHeading = 0.5;  // m/s, rad
 
-rsu_client::RsuRegistry rsuAtOrigin() {
-  rsu_client::RsuInfo rsu;
-  rsu.id = "rsu_a";
-  rsu.position = {0.0, 0.0};
-  rsu.lidar = *rsu_client::findLidarModel("VLP-32C");
-  rsu.coverage_radius = 80.0;
-  rsu.identity = "CN=rsu_a";
-  return rsu_client::RsuRegistry({rsu}, rsu_client::CovariancePlacement::kPublished);
-}
+rsu_client::RsuRegistry rsuAtOrigin() { return coloc::testing::oneRsu({0.0, 0.0}, 80.0); }
 
 Config egoConfig() {
   Config c;

@@ -8,6 +8,7 @@
 
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "measurements.hpp"
+#include "one_rsu.hpp"
 
 namespace coloc::pipeline {
 namespace {
@@ -17,15 +18,7 @@ using coloc::testing::kTick;
 using coloc::testing::planarPose;
 using coloc::testing::twist;
 
-rsu_client::RsuRegistry oneRsu() {
-  rsu_client::RsuInfo rsu;
-  rsu.id = "rsu_a";
-  rsu.position = {10.0, 0.0};
-  rsu.lidar = *rsu_client::findLidarModel("VLP-32C");
-  rsu.coverage_radius = 30.0;
-  rsu.identity = "CN=rsu_a";
-  return rsu_client::RsuRegistry({rsu}, rsu_client::CovariancePlacement::kPublished);
-}
+rsu_client::RsuRegistry oneRsu() { return coloc::testing::oneRsu({10.0, 0.0}, 30.0); }
 
 // This vehicle is station 1001; its RSU addresses its fixes to it.
 const Config kConfig = [] {
