@@ -247,7 +247,7 @@ struct Localizer::Impl {
     return out;
   }
 
-  FilterState initialState(const UpdateRecord& r) const {
+  FilterState initialState(const UpdateRecord& r, const std::optional<TwistMeasurement>& moving) const {
     FilterState s;
     s.x.setZero();
     s.P = Matrix6d::Zero();
@@ -259,13 +259,20 @@ struct Localizer::Impl {
     s.P(kYawBias, kYawBias) = config.enable_yaw_bias_estimation ? config.initial_yaw_bias_variance : 0.0;
     s.P(kVx, kVx) = config.initial_vx_variance;
     s.P(kWz, kWz) = config.initial_wz_variance;
+    // A vehicle started while moving: its odometry says how fast, so the first ticks do not predict it
+    // standing (a start from the roadside or a recovery happens at speed).
+    if (moving) {
+      const double var_vx = moving->covariance(0, 0), var_wz = moving->covariance(5, 5);
+      if (std::isfinite(moving->linear.x()) && std::isfinite(var_vx) && var_vx > 0.0) s.x[kVx] = moving->linear.x(), s.P(kVx, kVx) = var_vx;
+      if (std::isfinite(moving->angular.z()) && std::isfinite(var_wz) && var_wz > 0.0) s.x[kWz] = moving->angular.z(), s.P(kWz, kWz) = var_wz;
+    }
     for (int a = 0; a < 3; ++a)
       if (r.aux_mask & (1 << a)) s.aux[a] = {r.aux_value[a], r.aux_variance[a], true};
     return s;
   }
 
-  void start(Stamp stamp, const UpdateRecord& record) {
-    history.reset(stamp, initialState(record));
+  void start(Stamp stamp, const UpdateRecord& record, const std::optional<TwistMeasurement>& moving = std::nullopt) {
+    history.reset(stamp, initialState(record, moving));
     active.clear();  // their information went into the history just discarded
     initialized = true;
     if (!clock_set || clock < stamp) clock = stamp;
@@ -437,7 +444,7 @@ std::optional<SourceId> Localizer::findSource(std::string_view name) const {
   return it->second;
 }
 
-Verdict Localizer::initialize(const PoseMeasurement& pose) {
+Verdict Localizer::initialize(const PoseMeasurement& pose, const std::optional<TwistMeasurement>& moving) {
   const RecordOrError made = makePoseRecord(pose);
   Verdict v{Outcome::kRejected, Reason::kInvalid, InputKind::kInitialPose, "", pose.stamp, -1, 0.0, {}};
   if (const auto* why = std::get_if<std::string>(&made)) {
@@ -445,7 +452,7 @@ Verdict Localizer::initialize(const PoseMeasurement& pose) {
   } else if (!measuresPlanarPose(std::get<UpdateRecord>(made))) {
     v.detail = "x, y and yaw must all have finite variance";
   } else {
-    impl_->start(pose.stamp, std::get<UpdateRecord>(made));
+    impl_->start(pose.stamp, std::get<UpdateRecord>(made), moving);
     v = {Outcome::kApplied, Reason::kNone, InputKind::kInitialPose, "", pose.stamp, 0, 0.0, "filter initialised"};
   }
   return impl_->report(std::move(v));

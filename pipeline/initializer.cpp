@@ -20,6 +20,12 @@ void Initializer::addPosition(const std::string& source, Stamp stamp, const Eige
   while (!positions_.empty() && positions_.front().stamp < stamp - fromSeconds(config_.max_span)) positions_.pop_front();
 }
 
+void Initializer::setTwist(const TwistMeasurement& twist) {
+  if (!std::isfinite(twist.covariance(0, 0)) || !std::isfinite(twist.linear.x())) return;
+  twist_ = twist;
+  vx_ = twist.linear.x();
+}
+
 void Initializer::addScan(std::shared_ptr<const ndt::PointCloud> scan, Stamp stamp) {
   scans_.push_back({std::move(scan), stamp});
   while (scans_.size() > kKeptScans) scans_.pop_front();

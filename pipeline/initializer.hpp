@@ -42,7 +42,10 @@ class Initializer {
   void addPosition(const std::string& source, Stamp stamp, const Eigen::Vector2d& xy, double variance);
   /// Scans are kept a short while for the heading search.
   void addScan(std::shared_ptr<const ndt::PointCloud> scan, Stamp stamp);
-  void setSpeed(double vx) { vx_ = vx; }
+  /// The odometry's latest twist as the filter takes it (speed scaled): for deskewing the searched
+  /// scan, and for the filter to start at speed.
+  void setTwist(const TwistMeasurement& twist);
+  const std::optional<TwistMeasurement>& twist() const { return twist_; }
 
   /// A start from what has arrived, or nullopt (then `waiting` says what is missing). `ndt` may be
   /// null (no map). `heading_hint`: a heading to search near (a lost filter's own), with its tolerance.
@@ -67,6 +70,7 @@ class Initializer {
   std::deque<Scan> scans_;
   Stamp searched_scan_ = 0;  ///< the newest scan searched already (each is searched once)
   double vx_ = 0.0;
+  std::optional<TwistMeasurement> twist_;
 };
 
 }  // namespace coloc::pipeline

@@ -265,7 +265,7 @@ struct Pipeline::Impl {
 
   // A pose to start from; with `hint` (a lost filter's heading) a recovery.
   void start(const StartPose& start, const std::string& why) {
-    localizer.initialize(start.pose);
+    localizer.initialize(start.pose, initializer.twist());
     if (!localizer.initialized()) return;
     last_state = fusion::LocalizationState::kLocalized;
     noteState();
@@ -295,10 +295,19 @@ struct Pipeline::Impl {
     if (!found) return;
     ++report.recoveries;
     if (report.recovery_reasons.size() < kKeptRejections) report.recovery_reasons.push_back(why);
+    // NDT's poses of a filter that was lost matched another place: what they taught about the odometry
+    // and the mounting is not the vehicle's.
+    forgetLearned();
     start(*found, "recovered (" + why + ")");
   }
 
   bool lost() const { return localizer.integrity().state == fusion::LocalizationState::kLost; }
+
+  void forgetLearned() {
+    speed_scale = SpeedScaleEstimator(speed_scale_config);
+    yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
+    mount_yaw = MountYawEstimator(mount_yaw_config);
+  }
 
   // The clock went back (a log played again, a player restarted): everything the filter knew belongs
   // to the other timeline. As a ROS 2 node on a jump back in time, it starts again.
@@ -311,9 +320,7 @@ struct Pipeline::Impl {
     localizer.reset();
     initializer.reset();
     settling.clear();
-    speed_scale = SpeedScaleEstimator(speed_scale_config);
-    yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
-    mount_yaw = MountYawEstimator(mount_yaw_config);
+    forgetLearned();
     if (checker) checker->forgetRecent();
     first_input_seen = false;
     last_state = fusion::LocalizationState::kInitialising;
@@ -424,7 +431,6 @@ struct Pipeline::Impl {
       // A twist that measures speed (odometry, not an IMU) is scaled by what NDT taught about it, and
       // one that measures yaw rate has the bias NDT showed taken out.
       TwistMeasurement t = twist->twist;
-      if (std::isfinite(t.covariance(0, 0)) && std::isfinite(t.linear.x())) initializer.setSpeed(t.linear.x());
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
@@ -433,6 +439,7 @@ struct Pipeline::Impl {
         yaw_rate_bias.addTwist(t.stamp, t.angular.z());
         t.angular.z() -= yaw_rate_bias.bias();
       }
+      initializer.setTwist(t);
       if (on_twist_input) on_twist_input(source_names[twist->source], t, twist->twist);
       localizer.feedTwist(twist->source, t);
     } else if (auto* pose = std::get_if<PoseInput>(&input)) {

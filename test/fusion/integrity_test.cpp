@@ -4,6 +4,7 @@
 
 #include "coloc/fusion/localizer.hpp"
 #include "measurements.hpp"
+#include "motion_model.hpp"
 
 namespace coloc::fusion {
 namespace {
@@ -113,6 +114,29 @@ TEST(Integrity, AResetFilterIsInitialisingWithNoEstimate) {
   EXPECT_FALSE(d.filter.estimate().has_value());
   EXPECT_EQ(d.filter.integrity().state, LocalizationState::kInitialising);
   EXPECT_EQ(d.filter.feedPose(d.rsu, fix2d(d.now, 0.0, 0.0, 0.0002)).reason, Reason::kNotInitialized);
+}
+
+}  // namespace
+}  // namespace coloc::fusion
+
+namespace coloc::fusion {
+namespace {
+
+TEST(Start, AStartWhileMovingTakesItsSpeedAndYawRateFromTheOdometry) {
+  Localizer filter;
+  const TwistMeasurement moving = testing::twist(testing::kStart, 12.5, 0.05, 0.04, 0.01);
+  ASSERT_TRUE(filter.initialize(testing::planarPose(testing::kStart, 0.0, 0.0, 0.0), moving).applied());
+  const Estimate e = *filter.estimate();
+  EXPECT_EQ(e.state[kVx], 12.5);
+  EXPECT_EQ(e.state[kWz], 0.05);
+  EXPECT_EQ(e.state_covariance(kVx, kVx), 0.04);
+  // A twist that does not measure speed leaves it unknown, as a start without one does.
+  TwistMeasurement gyro = moving;
+  gyro.covariance(0, 0) = kInfinity;
+  ASSERT_TRUE(filter.initialize(testing::planarPose(testing::kStart, 0.0, 0.0, 0.0), gyro).applied());
+  EXPECT_EQ(filter.estimate()->state[kVx], 0.0);
+  EXPECT_EQ(filter.estimate()->state_covariance(kVx, kVx), EkfConfig().initial_vx_variance);
+  EXPECT_EQ(filter.estimate()->state[kWz], 0.05);
 }
 
 }  // namespace

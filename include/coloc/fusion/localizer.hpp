@@ -61,8 +61,10 @@ class Localizer {
   SourceId addTwistSource(const std::string& name);
   std::optional<SourceId> findSource(std::string_view name) const;
 
-  /// Starts (or restarts) the filter at a pose; x, y and yaw must be measured.
-  Verdict initialize(const PoseMeasurement& pose);
+  /// Starts (or restarts) the filter at a pose; x, y and yaw must be measured. `moving`: the vehicle's
+  /// twist then (the odometry's latest), which sets the speed and yaw rate the start otherwise leaves
+  /// unknown; components without a finite variance are ignored.
+  Verdict initialize(const PoseMeasurement& pose, const std::optional<TwistMeasurement>& moving = std::nullopt);
   bool initialized() const;
   /// Back to before the first initial pose (a clock that went back): the estimate, the history and
   /// every waiting measurement go; sources and counters stay.
