@@ -60,7 +60,8 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
   const auto wall_start = SteadyClock::now();
   const Duration clock_period = static_cast<Duration>(1e9 / options.clock_frequency);  // checked: 1 Hz or more
   const std::uint64_t total = std::max<std::uint64_t>(probe.messageCount(), 1);
-  for (bool first_pass = true; first_pass || options.loop; first_pass = false) {
+  for (bool first_pass = true; first_pass || (options.loop && (options.passes <= 0 || report.loops < static_cast<std::uint64_t>(options.passes)));
+       first_pass = false) {
     io::BagReader bag = io::BagReader::open(log_path, io::BagReadOptions{options.recover});
     io::BagMessage message;
     bool started = false;

@@ -110,7 +110,7 @@ ErrorSources readErrors(const Reader& r, const YAML::Node& n, const ErrorSources
 }
 
 TrafficVehicle readTraffic(const Reader& r, const YAML::Node& n, const std::string& where) {
-  r.keys(n, where, {"lane_offset", "start", "speed", "direction", "length", "width"});
+  r.keys(n, where, {"lane_offset", "start", "speed", "direction", "length", "width", "station_id"});
   TrafficVehicle v;
   if (n["lane_offset"]) v.lane_offset = r.inRange(n["lane_offset"], where + ".lane_offset", -50.0, 50.0);
   if (n["start"]) v.start = r.number(n["start"], where + ".start");
@@ -118,6 +118,7 @@ TrafficVehicle readTraffic(const Reader& r, const YAML::Node& n, const std::stri
   if (n["direction"]) v.oncoming = r.choice(n["direction"], where + ".direction", {"same", "oncoming"}) == "oncoming";
   if (n["length"]) v.body.length = r.inRange(n["length"], where + ".length", 2.5, 20.0);
   if (n["width"]) v.body.width = r.inRange(n["width"], where + ".width", 1.4, 3.0);
+  if (n["station_id"]) v.station_id = static_cast<std::uint32_t>(r.integer(n["station_id"], where + ".station_id", 0, 4294967295LL));
   return v;
 }
 
@@ -222,8 +223,12 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
     }
   }
   if (const YAML::Node t = root["traffic"]) {
-    if (!t.IsSequence()) r.fail(t, "traffic", "expected a list of {lane_offset, start, speed, direction, length, width}");
-    for (std::size_t i = 0; i < t.size(); ++i) s.traffic.push_back(readTraffic(r, t[i], "traffic[" + std::to_string(i) + "]"));
+    if (!t.IsSequence()) r.fail(t, "traffic", "expected a list of {lane_offset, start, speed, direction, length, width, station_id}");
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      s.traffic.push_back(readTraffic(r, t[i], "traffic[" + std::to_string(i) + "]"));
+      if (s.traffic.back().station_id && *s.traffic.back().station_id == s.vehicle_station_id)
+        r.fail(t[i]["station_id"], "traffic[" + std::to_string(i) + "].station_id", "is the ego vehicle's (vehicle.station_id)");
+    }
   }
   Route(s.route_start, s.route_heading, s.route);  // validates the pieces
   setErrorSources(s, root["errors"] ? readErrors(r, root["errors"]) : ErrorSources{});

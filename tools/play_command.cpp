@@ -30,6 +30,8 @@ void addPlayCommand(CLI::App& app) {
   cmd->add_option("--rate", options.rate, "playback speed: 2 = twice as fast as recorded")->check(finiteNumber(0.0, 1000.0, true))->capture_default_str();
   cmd->add_option("--topics", options.topics, "play only these topics");
   cmd->add_flag("--loop", options.loop, "start again at the end, until interrupted");
+  cmd->add_option("--passes", options.passes, "with --loop: stop after this many passes (0 = until interrupted)")
+      ->check(wholeNumber(0, 1000000))->capture_default_str();
   cmd->add_flag("--no-clock", no_clock, "do not publish the log's time on /clock");
   cmd->add_option("--clock-frequency", options.clock_frequency, "Hz of /clock between messages")->check(finiteNumber(1.0, 10000.0))->capture_default_str();
   cmd->add_option("--delay", options.delay, "seconds to wait before the first message, for discovery")->check(finiteNumber(0.0, 3600.0))->capture_default_str();

@@ -47,6 +47,9 @@ void addSimulateCommand(CLI::App& app) {
     std::printf("  %llu roof scans, %llu RSU fixes recorded (%llu lost on the link); %.1f M rays cast at %.2f M rays/s\n",
                 (unsigned long long)s.scans, (unsigned long long)s.fixes, (unsigned long long)s.fixes_lost, s.rays * 1e-6,
                 s.rays / std::max(s.ray_casting_seconds, 1e-9) * 1e-6);
+    if (s.connected_fixes)
+      std::printf("  %llu fixes sent to the other connected vehicles (addressed to them, on the same topics: the ego's log has them)\n",
+                  (unsigned long long)s.connected_fixes);
     std::printf("  time: survey map %.1f s, ray casting %.1f s, LiDAR noise and dropouts %.1f s, roadside perception %.2f s, the rest %.1f s\n",
                 s.map_seconds, s.ray_casting_seconds, s.lidar_seconds, s.perception_seconds,
                 s.wall_seconds - s.map_seconds - s.ray_casting_seconds - s.lidar_seconds - s.perception_seconds);

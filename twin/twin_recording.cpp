@@ -339,6 +339,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const sim::Drive drive(route, scenario.speed);
   sim::RandomEngine rng(scenario.seed);
   sim::RandomEngine ideal_rng(scenario.seed + 17), stamp_rng(scenario.seed + 29);  // own streams: the main one unchanged by them
+  std::mt19937_64 connected_rng(scenario.seed + 41);  // the other connected vehicles' CAM errors, likewise
   std::normal_distribution<double> stamp_jitter(0.0, 1.0);
 
   // 3. Roadside units: their background frames and perception.
@@ -352,7 +353,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     sim::LidarSpec ideal_lidar;
     std::unique_ptr<sim::RoadsidePerception> ideal_perception;
     sim::FixConsistency consistency{}, ideal_consistency{};
+    /// Per other connected vehicle: its track and its share of the radio link.
+    std::vector<sim::FixConsistency> connected_consistency;
+    std::vector<rsu_client::LinkEmulator> connected_links;
   };
+  std::vector<std::size_t> connected;  // the traffic that is connected
+  for (std::size_t i = 0; i < scenario.traffic.size(); ++i)
+    if (scenario.traffic[i].station_id) connected.push_back(i);
   std::vector<Rsu> rsus;
   for (const sim::ScenarioRsu& r : scenario.rsus) {
     sim::RsuMount mount;
@@ -372,6 +379,12 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       perception.emplace_back(reference, mount, c);
     }
     Rsu rsu{r, lidar, std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range, {}, nullptr};
+    for (std::size_t j = 0; j < connected.size(); ++j) {
+      rsu_client::LinkConfig own = l;
+      own.seed = l.seed * 1000003ULL + 104729ULL * (j + 1);  // its own draws: the ego's link unchanged by it
+      rsu.connected_consistency.emplace_back();
+      rsu.connected_links.emplace_back(own);
+    }
     if (ideal_world) {
       rsu.ideal_lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), sim::ErrorSources::ideal());
       rsu.ideal_perception = std::make_unique<sim::RoadsidePerception>(frameOf(rsu.ideal_lidar, surveyed, pose, ideal_rng), mount);
@@ -501,6 +514,29 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         frameOf(r.lidar, with_vehicle.caster(), pose, rng, frame_room, frame);
         summary.ray_casting_seconds += since(c1);  // the LiDAR model's share with it
         summary.rays += raysPerSweep(r.lidar);
+      }
+      // Every other connected vehicle in the same frame gets its own fix, found through its own CAM and
+      // addressed to its station id, on the same topic: the ego's radio hears them all.
+      for (std::size_t j = 0; j < connected.size(); ++j) {
+        const sim::TrafficVehicle& other = scenario.traffic[connected[j]];
+        const std::optional<Eigen::Vector3d> at_capture = sim::trafficPose(route, other, capture);
+        if (!at_capture || (at_capture->head<2>() - r.info.position).norm() > r.range) continue;
+        std::normal_distribution<double> cam_error(0.0, 0.3);
+        const Eigen::Vector2d cam_position = at_capture->head<2>() + Eigen::Vector2d(cam_error(connected_rng), cam_error(connected_rng));
+        sim::VehicleDetection od = r.perception[0].detect(frame, at(capture), cam_position, at_capture->z(), other.body.length, other.body.width);
+        const Eigen::Vector2d other_velocity = other.speed * Eigen::Vector2d(std::cos(at_capture->z()), std::sin(at_capture->z()));
+        if (!od.found) {
+          r.connected_consistency[j].miss();
+          continue;
+        }
+        if (!r.connected_consistency[j].agrees(od.stamp, od.position, other_velocity)) continue;
+        const std::optional<Stamp> sent = r.connected_links[j].transmit(at(capture + 0.05 + options.rsu_processing));
+        if (!sent) continue;
+        const Eigen::Vector2d local = Eigen::Rotation2Dd(r.info.yaw).inverse() * (od.position - r.info.position);
+        const Eigen::Vector2d reported = r.info.position + r.info.survey_error.head<2>() + Eigen::Rotation2Dd(r.info.yaw + r.info.survey_error.z()) * local;
+        bag.write(rsu_client::addressedFixTopic(r.info.id), *sent,
+                  io::encodeOdometry(addressedFix(at(capture) + fromSeconds(r.info.clock_offset), reported, r.variance, *other.station_id)));
+        ++summary.connected_fixes;
       }
       // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
       std::normal_distribution<double> cam(0.0, 0.3);

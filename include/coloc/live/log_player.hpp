@@ -18,6 +18,7 @@ struct PlayOptions {
   double rate = 1.0;                 ///< 2 = twice as fast as recorded
   std::vector<std::string> topics;   ///< empty: every topic
   bool loop = false;                 ///< start again at the end, until stopped
+  int passes = 0;                    ///< with loop: stop after this many passes (0: until stopped)
   bool publish_clock = true;         ///< the log's time on /clock (rosgraph_msgs/Clock)
   double clock_frequency = 100.0;    ///< Hz of /clock between messages (each message also sends its own time first)
   double delay = 0.0;                ///< s to wait after the writers are created (discovery) before the first message

@@ -89,6 +89,8 @@ struct TwinRecordingSummary {
   std::uint64_t rays = 0;            ///< rays cast
   std::uint64_t reused_sweeps = 0;   ///< sweeps and frames whose hits came from TwinRecordingOptions' caches
   std::uint64_t scans = 0, fixes = 0, fixes_lost = 0;
+  /// Fixes the RSUs sent the other connected vehicles (traffic with a station id), on the ego's log too.
+  std::uint64_t connected_fixes = 0;
   std::string map_dir;  ///< where the map the log goes with is
   /// Per RSU id: each fix's error (x, y) against ground truth, whether the link delivered it or not.
   std::map<std::string, std::vector<Eigen::Vector2d>> fix_errors;
