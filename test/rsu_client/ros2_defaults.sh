@@ -29,11 +29,15 @@ else
   echo "network: loopback with a multicast route"
 fi
 
-exchange() {  # NAME: a listener with defaults, the Cyclone node publishing 10 fixes
-  local name=$1
-  bounded 60 "$work/listen_$name.txt" "$coloc" rsu-listen --registry "$registry" --accept-unaddressed --timeout 45 --idle-exit 3 &
+exchange() {  # NAME [STATION]: a listener with defaults, the Cyclone node publishing 10 fixes (addressed to STATION, or unaddressed)
+  local name=$1 station=${2:-}
+  if [ -n "$station" ]; then
+    bounded 60 "$work/listen_$name.txt" "$coloc" rsu-listen --registry "$registry" --station-id "$station" --timeout 45 --idle-exit 3 &
+  else
+    bounded 60 "$work/listen_$name.txt" "$coloc" rsu-listen --registry "$registry" --accept-unaddressed --timeout 45 --idle-exit 3 &
+  fi
   local listener=$!
-  bounded 40 "$work/cyclone_$name.txt" "$publisher" rsu_a 10 95 -3 0.01486 30
+  bounded 40 "$work/cyclone_$name.txt" "$publisher" rsu_a 10 95 -3 0.01486 30 $station
   wait "$listener"
   local accepted
   accepted=$(grep -c ' accepted (variance' "$work/listen_$name.txt" || true)
@@ -41,9 +45,9 @@ exchange() {  # NAME: a listener with defaults, the Cyclone node publishing 10 f
   [ "$accepted" -eq 10 ] || { echo "FAIL ($name): expected 10 accepted fixes, got $accepted"; exit 1; }
 }
 
-exchange defaults
+exchange defaults 7  # addressed fixes, the protocol, as a ROS 2 node publishes them with standard types
 grep -q 'domain 0, every interface' "$work/listen_defaults.txt" || { echo "FAIL: coloc did not run on domain 0, every interface"; exit 1; }
 export ROS_DOMAIN_ID=42
-exchange ros_domain_id
+exchange ros_domain_id  # the unaddressed form, taken with --accept-unaddressed
 grep -q 'domain 42, every interface' "$work/listen_ros_domain_id.txt" || { echo "FAIL: coloc did not take ROS_DOMAIN_ID"; exit 1; }
 echo "a default ROS 2 node (Cyclone DDS) and coloc's default participant exchanged fixes"
