@@ -27,6 +27,7 @@ void IntegrityMonitor::restart(Stamp stamp, bool initialized) {
   cause_ = Cause::kNone;
   inflation_.setZero();
   anchor_gated_in_a_row_ = 0;
+  anchor_window_.clear();
   last_applied_ = stamp;
 }
 
@@ -51,6 +52,7 @@ void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool appli
       anchor_gated_in_a_row_ = 0;
       // An anchor that agrees again ends whatever its disagreement started.
       if (cause_ == Cause::kAnchor) enter(LocalizationState::kLocalized, Cause::kNone, {}, now);
+      onAnchorApplied(source, innovation, d2, now);
     } else {
       // Gated fixes that disagree by the same vector are one story told again: the filter is off by it.
       const bool same_story = anchor_gated_in_a_row_ > 0 && (innovation - anchor_disagreement_).norm() <= config_.integrity_anchor_agreement;
@@ -93,6 +95,27 @@ void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool appli
     gated_source_ = source;
     enter(LocalizationState::kDegraded, Cause::kGated, why.str(), now);
   }
+}
+
+void IntegrityMonitor::onAnchorApplied(const std::string& source, const Eigen::Vector2d& innovation, double d2, Stamp now) {
+  const std::size_t n = static_cast<std::size_t>(config_.integrity_anchor_window);
+  if (n == 0) return;
+  anchor_window_.push_back({now, innovation, d2});
+  while (anchor_window_.size() > n || (!anchor_window_.empty() && anchor_window_.front().at < now - fromSeconds(2.0))) anchor_window_.pop_front();
+  if (anchor_window_.size() < n) return;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  double mean_d2 = 0.0;
+  for (const AnchorUse& u : anchor_window_) mean += u.innovation / n, mean_d2 += u.d2 / n;
+  if (mean_d2 <= config_.integrity_anchor_mean_nis) return;
+  for (const AnchorUse& u : anchor_window_)
+    if ((u.innovation - mean).norm() > config_.integrity_anchor_agreement) return;  // outliers, not one story
+  std::ostringstream why;
+  why.precision(3);
+  why << "the last " << n << " poses of " << source << " disagree with the filter by " << mean.norm() << " m on average (mean squared Mahalanobis distance "
+      << mean_d2 << ")";
+  inflation_ = mean * mean.transpose();
+  anchor_window_.clear();
+  enter(LocalizationState::kLost, Cause::kAnchor, why.str(), now);
 }
 
 void IntegrityMonitor::onTick(Stamp now) {

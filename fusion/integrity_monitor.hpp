@@ -2,6 +2,7 @@
 // The filter's integrity from what its sources say at each pose's first use (applied or gated, and by
 // how much), and from how long it has gone on the twist alone. The Localizer feeds it; see
 // coloc/fusion/integrity.hpp for the states.
+#include <deque>
 #include <string>
 
 #include "coloc/core/types.hpp"
@@ -30,6 +31,8 @@ class IntegrityMonitor {
  private:
   enum class Cause { kNone, kAnchor, kGated, kDeadReckoning };
   void enter(LocalizationState state, Cause cause, std::string reason, Stamp now);
+  /// An applied anchor pose: lost if the window's poses, far off on average, tell one story.
+  void onAnchorApplied(const std::string& source, const Eigen::Vector2d& innovation, double d2, Stamp now);
 
   EkfConfig config_;
   IntegrityStatus status_;
@@ -39,6 +42,12 @@ class IntegrityMonitor {
   int anchor_gated_in_a_row_ = 0;
   Eigen::Vector2d anchor_disagreement_ = Eigen::Vector2d::Zero();
   Stamp anchor_gated_at_ = 0;
+  struct AnchorUse {
+    Stamp at;
+    Eigen::Vector2d innovation;
+    double d2;
+  };
+  std::deque<AnchorUse> anchor_window_;  ///< the last anchor poses applied, for their mean disagreement
   std::string gated_source_;  ///< the other source whose gated run degraded the filter
   Stamp last_applied_ = 0;
 };

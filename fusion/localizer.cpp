@@ -35,6 +35,8 @@ void validate(const EkfConfig& c) {
   requireConfig(c.twist_gate_alpha >= 0.0 && c.twist_gate_alpha < 1.0, "twist_gate_alpha", "must be in [0, 1)");
   requireConfig(c.integrity_lost_after_gated_anchors >= 0, "integrity_lost_after_gated_anchors", "must be >= 0");
   requireConfig(c.integrity_degraded_after_gated >= 0, "integrity_degraded_after_gated", "must be >= 0");
+  requireConfig(c.integrity_anchor_window >= 0 && c.integrity_anchor_window <= 1000, "integrity_anchor_window", "must be in [0, 1000]");
+  requireConfig(std::isfinite(c.integrity_anchor_mean_nis) && c.integrity_anchor_mean_nis > 0.0, "integrity_anchor_mean_nis", "must be finite and > 0");
   const std::pair<const char*, double> non_negative[] = {
       {"proc_stddev_yaw_c", c.proc_stddev_yaw_c},       {"proc_stddev_vx_c", c.proc_stddev_vx_c},
       {"proc_stddev_wz_c", c.proc_stddev_wz_c},         {"z_filter_proc_dev", c.z_filter_proc_dev},

@@ -434,6 +434,7 @@ struct Pipeline::Impl {
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
+        t.covariance(0, 0) += speed_scale.scaleVariance() * t.linear.x() * t.linear.x();
       }
       if (std::isfinite(t.covariance(5, 5))) {
         yaw_rate_bias.addTwist(t.stamp, t.angular.z());

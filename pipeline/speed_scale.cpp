@@ -4,14 +4,25 @@
 
 namespace coloc::pipeline {
 
+double SpeedScaleEstimator::scaleVariance() const {
+  if (!config_.enabled) return 0.0;
+  if (!usable()) return config_.prior_sd * config_.prior_sd;
+  const double sd = std::sqrt(2.0) * config_.position_noise / compared_;
+  return sd * sd;
+}
+
 void SpeedScaleEstimator::addTwist(Stamp stamp, double vx) { odometry_.add(stamp, std::abs(vx)); }
 
 void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position) {
   if (!config_.enabled || odometry_.empty() || !position.allFinite()) return;
   const double odometry = odometry_.at(stamp);
   if (!anchor_) {
-    anchor_ = {position, odometry};
-    return;
+    if (candidate_) {
+      const double moved = (position - candidate_->first).norm(), claimed = odometry - candidate_->second;
+      if (claimed >= 0.0 && std::abs(moved - claimed) <= config_.anchor_agreement) anchor_ = candidate_;
+    }
+    candidate_ = {position, odometry};
+    if (!anchor_) return;
   }
   const double travelled = odometry - anchor_->second;
   if (travelled < config_.chord) {

@@ -141,3 +141,29 @@ TEST(Start, AStartWhileMovingTakesItsSpeedAndYawRateFromTheOdometry) {
 
 }  // namespace
 }  // namespace coloc::fusion
+
+namespace coloc::fusion {
+namespace {
+
+TEST(Integrity, AnchorsAppliedButFarOffAgainAndAgainMakeItLost) {
+  // The map matching holds the filter 25 cm off, the fixes (2 cm) just inside the gate each time.
+  Localizer filter;
+  const SourceId odom = filter.addTwistSource("odom"), ndt = filter.addPoseSource("ndt"), rsu = filter.addPoseSource("/rsu/a/fix", 0, true);
+  filter.initialize(testing::planarPose(testing::kStart, 0.0, 0.0, 0.0, 0.0225, 0.0001));
+  Stamp now = testing::kStart;
+  for (int i = 0; i < 12 && filter.integrity().state != LocalizationState::kLost; ++i) {
+    for (int k = 0; k < 5; ++k) {
+      now += testing::kTick;
+      filter.feedTwist(odom, testing::twist(now, 0.0, 0.0));
+      filter.advanceTo(now);
+    }
+    filter.feedPose(ndt, testing::planarPose(now, 0.0, 0.0, 0.0, 0.0004));
+    const Verdict v = filter.feedPose(rsu, testing::fix2d(now, 0.0, 0.25, 0.0004));
+    EXPECT_NE(v.reason, Reason::kGated) << "fix " << i;
+  }
+  EXPECT_EQ(filter.integrity().state, LocalizationState::kLost);
+  EXPECT_NE(filter.integrity().reason.find("on average"), std::string::npos) << filter.integrity().reason;
+}
+
+}  // namespace
+}  // namespace coloc::fusion

@@ -12,7 +12,7 @@ constexpr Stamp kStart = 1'700'000'000'000'000'000LL;
 // A drive at `speed` along x: odometry at 50 Hz reading `scale` times the true speed with white noise,
 // and NDT poses at 10 Hz with 2 cm of noise, each matched 105 ms after its stamp (when it reaches the
 // estimator, the odometry has moved on).
-SpeedScaleEstimator drive(double speed, double odometry_scale, double seconds, double jump_at = -1.0) {
+SpeedScaleEstimator drive(double speed, double odometry_scale, double seconds, double jump_at = -1.0, double first_pose_off = 0.0) {
   SpeedScaleEstimator estimator;
   std::mt19937 rng(3);
   std::normal_distribution<double> odometry_noise(0.0, 0.05), pose_noise(0.0, 0.02);
@@ -23,6 +23,7 @@ SpeedScaleEstimator drive(double speed, double odometry_scale, double seconds, d
       const double taken = t - 0.105;
       Eigen::Vector2d p(speed * taken + pose_noise(rng), pose_noise(rng));
       if (jump_at >= 0.0 && std::abs(taken - jump_at) < 0.01) p.x() += 3.0;  // one NDT result that slipped
+      if (std::abs(taken) < 0.01) p.x() += first_pose_off;
       estimator.addPose(kStart + static_cast<Stamp>(taken * 1e9), p);
     }
   }
@@ -44,6 +45,21 @@ TEST(SpeedScale, IsOneUntilEnoughTravelWasCompared) {
   const SpeedScaleEstimator e = drive(10.0, 1.05, 1.0);  // 10 m: not yet the 15 m it needs
   EXPECT_FALSE(e.usable());
   EXPECT_EQ(e.scale(), 1.0);
+}
+
+TEST(SpeedScale, ABadFirstMatchDoesNotStartTheComparedTravel) {
+  // 37 cm along at the first pose (NDT's first match after a start, site C): as the start of the
+  // first chord it read the scale 3 % low at 15 m; the next pose, which disagrees with it, starts it.
+  const SpeedScaleEstimator e = drive(10.0, 1.01, 2.5, -1.0, 0.37);
+  ASSERT_TRUE(e.usable());
+  EXPECT_NEAR(e.scale(), 1.0 / 1.01, 0.004);
+}
+
+TEST(SpeedScale, ItsUncertaintyIsThePriorsUntilUsableThenShrinksWithTheTravelCompared) {
+  const SpeedScaleEstimator early = drive(10.0, 1.01, 1.0), later = drive(10.0, 1.01, 20.0);
+  EXPECT_EQ(early.scaleVariance(), 0.02 * 0.02);
+  EXPECT_LT(later.scaleVariance(), 0.002 * 0.002);
+  EXPECT_GT(later.scaleVariance(), 0.0);
 }
 
 TEST(SpeedScale, AnNdtJumpIsNotTakenForAScale) {

@@ -68,6 +68,12 @@ struct EkfConfig {
   /// disagreement, that make the filter `lost` (one makes it `degraded`). 0 = never lost by anchors.
   int integrity_lost_after_gated_anchors = 2;
   double integrity_anchor_agreement = 1.0;  ///< m
+  /// Anchor poses applied but far off, again and again: the last this many (within 2 s) whose mean
+  /// squared Mahalanobis distance exceeds integrity_anchor_mean_nis, telling the same story, make the
+  /// filter `lost` too (its map matching holds it in a wrong place just inside the gate). 0 = off.
+  int integrity_anchor_window = 5;
+  /// Chi-square(2)'s 0.999 quantile: the mean of 5 consistent draws exceeds it with a chance of about 1e-10.
+  double integrity_anchor_mean_nis = 13.8;
   /// Poses of any other source gated in a row that make the filter `degraded`. 0 = off.
   int integrity_degraded_after_gated = 5;
   /// Seconds without any pose applied (dead reckoning on the twist alone) that make it `degraded`. 0 = off.
