@@ -35,6 +35,7 @@ const std::vector<EkfParam>& ekfParams() {
       {"integrity_anchor_agreement", "m", "gated anchor poses whose disagreements with the filter differ by less than this tell the same story", &C::integrity_anchor_agreement},
       {"integrity_anchor_window", "poses", "the last anchor poses (within 2 s) whose mean squared Mahalanobis distance, telling one story, makes the filter lost; 0 = off", &C::integrity_anchor_window},
       {"integrity_anchor_mean_nis", "", "that mean's limit (chi-square(2) 0.999 quantile: 13.8)", &C::integrity_anchor_mean_nis},
+      {"integrity_lost_min_distance", "m", "lost only when the anchors' disagreement is at least this (an RSU's own error could tell a smaller one); below, degraded", &C::integrity_lost_min_distance},
       {"integrity_degraded_after_gated", "poses", "poses of another source (NDT) gated in a row that make the filter degraded; 0 = off", &C::integrity_degraded_after_gated},
       {"integrity_dead_reckoning_limit", "s", "time without any pose applied that makes the filter degraded; 0 = off", &C::integrity_dead_reckoning_limit},
       {"integrity_anchor_memory", "s", "time of other poses applied after which one gated anchor pose (an outlier) no longer degrades the filter", &C::integrity_anchor_memory},

@@ -50,8 +50,11 @@ void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool appli
   if (anchor && planar) {
     if (applied) {
       anchor_gated_in_a_row_ = 0;
-      // An anchor that agrees again ends whatever its disagreement started.
-      if (cause_ == Cause::kAnchor) enter(LocalizationState::kLocalized, Cause::kNone, {}, now);
+      // An anchor that agrees again ends whatever its disagreement started; one that agrees well
+      // (within chi-square(2)'s 0.99 quantile) confirms a doubted position.
+      const bool confirms = d2 <= 9.21;
+      if (confirms) status_.doubted = false;
+      if (cause_ == Cause::kAnchor || (cause_ == Cause::kDoubt && confirms)) enter(LocalizationState::kLocalized, Cause::kNone, {}, now);
       onAnchorApplied(source, innovation, d2, now);
     } else {
       // Gated fixes that disagree by the same vector are one story told again: the filter is off by it.
@@ -63,7 +66,7 @@ void IntegrityMonitor::onPose(const std::string& source, bool anchor, bool appli
       std::ostringstream why;
       why.precision(3);
       const int lost_after = config_.integrity_lost_after_gated_anchors;
-      if (lost_after > 0 && anchor_gated_in_a_row_ >= lost_after) {
+      if (lost_after > 0 && anchor_gated_in_a_row_ >= lost_after && innovation.norm() >= lostDistance()) {
         why << anchor_gated_in_a_row_ << " poses of " << source << " in a row disagree with the filter by " << innovation.norm()
             << " m (squared Mahalanobis distance " << d2 << ")";
         enter(LocalizationState::kLost, Cause::kAnchor, why.str(), now);
@@ -102,20 +105,33 @@ void IntegrityMonitor::onAnchorApplied(const std::string& source, const Eigen::V
   if (n == 0) return;
   anchor_window_.push_back({now, innovation, d2});
   while (anchor_window_.size() > n || (!anchor_window_.empty() && anchor_window_.front().at < now - fromSeconds(2.0))) anchor_window_.pop_front();
-  if (anchor_window_.size() < n) return;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   double mean_d2 = 0.0;
-  for (const AnchorUse& u : anchor_window_) mean += u.innovation / n, mean_d2 += u.d2 / n;
-  if (mean_d2 <= config_.integrity_anchor_mean_nis) return;
-  for (const AnchorUse& u : anchor_window_)
-    if ((u.innovation - mean).norm() > config_.integrity_anchor_agreement) return;  // outliers, not one story
+  for (const AnchorUse& u : anchor_window_) mean += u.innovation / anchor_window_.size(), mean_d2 += u.d2 / anchor_window_.size();
+  bool one_story = anchor_window_.size() == n;
+  for (const AnchorUse& u : anchor_window_) one_story = one_story && (u.innovation - mean).norm() <= config_.integrity_anchor_agreement;
+  if (!one_story || mean_d2 <= config_.integrity_anchor_mean_nis) {
+    if (cause_ == Cause::kAnchorWindow) enter(LocalizationState::kLocalized, Cause::kNone, {}, now);
+    return;
+  }
   std::ostringstream why;
   why.precision(3);
   why << "the last " << n << " poses of " << source << " disagree with the filter by " << mean.norm() << " m on average (mean squared Mahalanobis distance "
       << mean_d2 << ")";
+  if (mean.norm() >= lostDistance()) {
+    anchor_window_.clear();
+    enter(LocalizationState::kLost, Cause::kAnchor, why.str(), now);
+  } else if (status_.state != LocalizationState::kLost) {
+    enter(LocalizationState::kDegraded, Cause::kAnchorWindow, why.str(), now);
+  }
   inflation_ = mean * mean.transpose();
-  anchor_window_.clear();
-  enter(LocalizationState::kLost, Cause::kAnchor, why.str(), now);
+}
+
+void IntegrityMonitor::doubt(const std::string& reason, const Eigen::Vector2d& offset, Stamp now) {
+  if (status_.state == LocalizationState::kInitialising || status_.state == LocalizationState::kLost || !offset.allFinite()) return;
+  enter(LocalizationState::kDegraded, Cause::kDoubt, reason, now);
+  status_.doubted = true;
+  inflation_ = offset * offset.transpose();
 }
 
 void IntegrityMonitor::onTick(Stamp now) {

@@ -21,6 +21,9 @@ class IntegrityMonitor {
   /// `gated_in_a_row`: the source's poses gated in a row, this one included (the Localizer keeps it).
   void onPose(const std::string& source, bool anchor, bool applied, const Eigen::Vector2d& innovation, double d2, int gated_in_a_row,
               Stamp now);
+  /// Another part of the system doubts the estimate by `offset` (x, y): degraded, its reported
+  /// covariance covering the offset, until an anchor agrees with it (or the filter starts again).
+  void doubt(const std::string& reason, const Eigen::Vector2d& offset, Stamp now);
   /// The filter's clock advanced to `now`.
   void onTick(Stamp now);
 
@@ -29,9 +32,10 @@ class IntegrityMonitor {
   const Eigen::Matrix2d& inflation() const { return inflation_; }
 
  private:
-  enum class Cause { kNone, kAnchor, kGated, kDeadReckoning };
+  enum class Cause { kNone, kAnchor, kAnchorWindow, kGated, kDeadReckoning, kDoubt };
   void enter(LocalizationState state, Cause cause, std::string reason, Stamp now);
-  /// An applied anchor pose: lost if the window's poses, far off on average, tell one story.
+  /// An applied anchor pose: the window's poses far off on average, telling one story, make the filter
+  /// lost (a metre or more) or degraded; back under the limit, localized again.
   void onAnchorApplied(const std::string& source, const Eigen::Vector2d& innovation, double d2, Stamp now);
 
   EkfConfig config_;
@@ -48,7 +52,10 @@ class IntegrityMonitor {
     double d2;
   };
   std::deque<AnchorUse> anchor_window_;  ///< the last anchor poses applied, for their mean disagreement
-  std::string gated_source_;  ///< the other source whose gated run degraded the filter
+  std::string gated_source_;
+  /// While the position is doubted (status_.doubted), an anchor's disagreement of any size means
+  /// lost, since the map no longer vouches for it.
+  double lostDistance() const { return status_.doubted ? 0.0 : config_.integrity_lost_min_distance; }  ///< the other source whose gated run degraded the filter
   Stamp last_applied_ = 0;
 };
 

@@ -44,6 +44,7 @@ void validate(const EkfConfig& c) {
       {"threshold_observable_velocity_mps", c.threshold_observable_velocity_mps},
       {"future_tolerance", c.future_tolerance},         {"initial_yaw_bias_variance", c.initial_yaw_bias_variance},
       {"integrity_anchor_agreement", c.integrity_anchor_agreement},
+      {"integrity_lost_min_distance", c.integrity_lost_min_distance},
       {"integrity_dead_reckoning_limit", c.integrity_dead_reckoning_limit},
       {"integrity_anchor_memory", c.integrity_anchor_memory}};
   for (const auto& [key, value] : non_negative) requireConfig(std::isfinite(value) && value >= 0.0, key, "must be finite and >= 0");
@@ -281,6 +282,9 @@ struct Localizer::Impl {
     clock_set = true;
     for (Source& s : sources) s.gated_in_a_row = 0;  // a run of gated poses was against the old start
     integrity.restart(stamp, true);
+    // A start at a stamp the clock has passed (a scan matched after it arrived) is predicted up to the
+    // clock, so that the estimate is always at the newest tick.
+    while (history.latestStamp() + history.options().step <= clock) history.advance();
     // Waiting measurements older than the new start can never find their tick.
     std::vector<Pending> waiting;
     waiting.swap(pending);
@@ -475,6 +479,10 @@ void Localizer::reset() {
 }
 
 const IntegrityStatus& Localizer::integrity() const { return impl_->integrity.status(); }
+
+void Localizer::doubt(const std::string& reason, const Eigen::Vector2d& offset) {
+  if (impl_->initialized) impl_->integrity.doubt(reason, offset, impl_->history.latestStamp());
+}
 
 Verdict Localizer::feedPose(SourceId source, const PoseMeasurement& m) {
   return impl_->feed(source, SourceKind::kPose, m.stamp, makePoseRecord(m));

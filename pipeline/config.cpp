@@ -50,7 +50,7 @@ std::string yamlNumber(double v) {
 template <typename Vector>
 std::string yamlList(const Vector& v) {
   std::string s = "[";
-  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + yamlNumber(v[i]);
+  for (int i = 0; i < static_cast<int>(v.size()); ++i) s += (i ? ", " : "") + yamlNumber(v[i]);
   return s + "]";
 }
 
@@ -273,6 +273,18 @@ const std::vector<Key>& keys() {
          for (int i = 0; i < 4; ++i)
            if (!std::isfinite(v[i])) r.fail(n[i], k, "must be finite");
          c.pipeline.initial_pose = Eigen::Vector4d(v[0], v[1], v[2], v[3]); }},
+      {"pipeline", "start_check_radii", "m", "a pose given by hand is held against the map at the next scan: NDT also starts from rings of these radii around it; [] = no check",
+       [](const C& c) { return yamlList(c.pipeline.start_check_radii); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.start_check_radii = n.IsSequence() && n.size() == 0 ? std::vector<double>{} : r.numberList(n, k, 0.1, 50.0); }},
+      {"pipeline", "start_check_margin", "NVTL", "a match that much better (and more than 1 m away) makes the filter degraded until an RSU's fix agrees",
+       [](const C& c) { return show(c.pipeline.start_check_margin); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.start_check_margin = r.inRange(n, k, 0.0, 10.0); }},
+      {"pipeline", "start_check_interval", "s", "the check is made again this often until an RSU's fix agrees with the filter",
+       [](const C& c) { return show(c.pipeline.start_check_interval); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.start_check_interval = r.inRange(n, k, 0.1, 3600.0); }},
+      {"pipeline", "start_check_duration", "s", "... for this long after the start (over a whole drive, a better match elsewhere turns up by chance)",
+       [](const C& c) { return show(c.pipeline.start_check_duration); },
+       [](const R& r, const N& n, const S& k, C& c) { c.pipeline.start_check_duration = r.inRange(n, k, 0.0, 86400.0); }},
       {"pipeline", "speed_scale_estimation", "", "learn the odometry's speed scale (wheel radius error) from NDT's poses and correct twists by it",
        [](const C& c) { return S(c.pipeline.speed_scale_estimation ? "true" : "false"); },
        [](const R& r, const N& n, const S& k, C& c) { c.pipeline.speed_scale_estimation = r.flag(n, k); }},

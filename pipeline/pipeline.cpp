@@ -6,6 +6,7 @@
 #include <condition_variable>
 #include <deque>
 #include <set>
+#include <sstream>
 #include <thread>
 #include <variant>
 
@@ -161,6 +162,10 @@ struct Pipeline::Impl {
   fusion::SourceId ndt_id = -1;
   std::set<fusion::SourceId> anchors;  // the RSUs' fix sources
   Initializer initializer;
+  // A start given by hand is held against the map at the next scan and every start_check_interval
+  // after, until an RSU's fix agrees with the filter.
+  bool check_start = false;
+  Stamp next_start_check = 0, start_check_end = 0;
   fusion::LocalizationState last_state = fusion::LocalizationState::kInitialising;
   std::optional<rsu_client::FixChecker> checker;
   std::map<std::string, fusion::SourceId> fix_sources;  // by RSU id
@@ -303,6 +308,32 @@ struct Pipeline::Impl {
 
   bool lost() const { return localizer.integrity().state == fusion::LocalizationState::kLost; }
 
+  // A pose given by hand is a person's guess, and NDT started from a wrong one confirms it: the first
+  // scan after it is also matched from rings around it. A clearly better match elsewhere makes the
+  // filter degraded, its reported covariance covering the distance, until an RSU's fix agrees.
+  void checkStart(const ScanInput& scan, const fusion::Estimate& guess) {
+    next_start_check = scan.stamp + fromSeconds(config.pipeline.start_check_interval);
+    if (!ndt || config.pipeline.start_check_radii.empty() || localizer.integrity().state != fusion::LocalizationState::kLocalized) return;
+    ndt::ScanOutcome at_start, best;
+    {
+      std::lock_guard<std::mutex> using_ndt(ndt_use);
+      best = ndt->searchAround(*scan.cloud, scan.stamp, guess.pose, config.pipeline.start_check_radii, 8, guess.state[4], at_start);
+    }
+    ++report.start_checks;
+    if (!best.produced) return;
+    const Eigen::Vector2d offset = best.pose.pose.position.head<2>() - guess.pose.position.head<2>();
+    const double own = at_start.produced ? at_start.alignment.nvtl : 0.0;
+    const bool elsewhere = !at_start.produced || (best.pose.pose.position - at_start.pose.pose.position).head<2>().norm() > 1.0;
+    if (!elsewhere || best.alignment.nvtl < own + config.pipeline.start_check_margin) return;
+    std::ostringstream why;
+    why.precision(3);
+    why << "NDT matches the map better " << offset.norm() << " m from the filter's estimate, which a pose given by hand started (NVTL " << best.alignment.nvtl << " against "
+        << own << ")";
+    localizer.doubt(why.str(), offset);
+    noteState();
+    check_start = false;  // degraded now, until an RSU's fix agrees
+  }
+
   void forgetLearned() {
     speed_scale = SpeedScaleEstimator(speed_scale_config);
     yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
@@ -389,7 +420,10 @@ struct Pipeline::Impl {
     }
     // NDT's poses, where the filter takes them, anchor the odometry's speed scale and yaw-rate bias
     // and the mounting yaw (each from NDT's poses as matched: the yaw's differences do not see it).
-    if (!feedPose(ndt_id, pose).rejected()) {
+    // Not while the filter is lost or its position doubted by the map: NDT's poses may then match
+    // another place, and what they would teach about the odometry is not the vehicle's.
+    const fusion::IntegrityStatus& integrity = localizer.integrity();
+    if (!feedPose(ndt_id, pose).rejected() && integrity.state != fusion::LocalizationState::kLost && !integrity.doubted) {
       speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
       yaw_rate_bias.addPose(outcome.pose.stamp, raw_yaw);
       mount_yaw.addPose(outcome.pose.pose.position.head<2>(), raw_yaw);
@@ -420,6 +454,11 @@ struct Pipeline::Impl {
         ++report.scans_without_guess;
         return;
       }
+      if (check_start && scan->stamp >= next_start_check) {
+        if (next_start_check == 0) start_check_end = scan->stamp + fromSeconds(config.pipeline.start_check_duration);
+        if (scan->stamp <= start_check_end) checkStart(*scan, *guess);
+        else check_start = false;
+      }
       if (ndt_thread) {
         if (!ndt_thread->submit(std::move(scan->cloud), scan->stamp, *guess)) ++report.scans_superseded;
         return;
@@ -434,7 +473,6 @@ struct Pipeline::Impl {
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
-        t.covariance(0, 0) += speed_scale.scaleVariance() * t.linear.x() * t.linear.x();
       }
       if (std::isfinite(t.covariance(5, 5))) {
         yaw_rate_bias.addTwist(t.stamp, t.angular.z());
@@ -464,13 +502,15 @@ struct Pipeline::Impl {
       const fusion::SourceId source = fix_sources.at(fix->fix.rsu_id);
       initializer.addPosition(source_names[source], v.measurement.stamp, v.measurement.pose.position.head<2>(), v.measurement.covariance(0, 0));
       if (!localizer.initialized()) tryStart();
-      feedPose(source, v.measurement);
+      if (feedPose(source, v.measurement).applied()) check_start = false;  // the roadside agrees: the start is confirmed
       if (lost()) tryRecover();
     } else {
       const PoseMeasurement& pose = std::get<InitialPoseInput>(input).pose;
       localizer.initialize(pose);
       if (localizer.initialized()) {
         ++report.starts;
+        check_start = true;
+        next_start_check = 0;
         report.started_how = "initial pose";
         last_state = fusion::LocalizationState::kLocalized;
         noteState();
@@ -492,6 +532,8 @@ struct Pipeline::Impl {
           localizer.initialize(initialPose(*config.pipeline.initial_pose, stampOf(input)));
           if (localizer.initialized()) {
             ++report.starts;
+            check_start = true;
+            next_start_check = 0;
             report.started_how = "pipeline.initial_pose";
             event(formatSeconds(stampOf(input)) + " started: pipeline.initial_pose");
           }

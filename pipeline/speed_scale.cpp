@@ -4,13 +4,6 @@
 
 namespace coloc::pipeline {
 
-double SpeedScaleEstimator::scaleVariance() const {
-  if (!config_.enabled) return 0.0;
-  if (!usable()) return config_.prior_sd * config_.prior_sd;
-  const double sd = std::sqrt(2.0) * config_.position_noise / compared_;
-  return sd * sd;
-}
-
 void SpeedScaleEstimator::addTwist(Stamp stamp, double vx) { odometry_.add(stamp, std::abs(vx)); }
 
 void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position) {

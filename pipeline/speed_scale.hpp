@@ -19,10 +19,6 @@ struct SpeedScaleConfig {
   double memory = 500.0;       ///< m of travel over which old comparisons fade to 1/e
   double min_distance = 15.0;  ///< m of odometry travel before the estimate is used
   double max_error = 0.1;      ///< a scale further than this from 1 is refused (counted)
-  /// Until the scale is usable, a wheel's scale error is this uncertain (tyres: 0.5-2 %).
-  double prior_sd = 0.02;
-  /// NDT's position noise at the two ends of the compared travel, which sets the scale's own error.
-  double position_noise = 0.15;  ///< m
   /// The first chord starts at a pose whose successor agrees with it within this (travel against the
   /// odometry's): a lone bad match there would bias every comparison until the memory forgets it,
   /// where one in the middle of the travel cancels between its two chords.
@@ -39,10 +35,6 @@ class SpeedScaleEstimator {
   void addPose(Stamp stamp, const Eigen::Vector2d& position);
   /// True speed per measured speed; 1 until enough travel was compared.
   double scale() const { return usable() ? estimate_ : 1.0; }
-  /// How uncertain scale() is, as a variance: the prior's until usable, then the error the ends of the
-  /// compared travel leave (their noise over the distance). A speed scaled by it is that much less
-  /// certain, so that the filter trusts the odometry only as far as its calibration is known.
-  double scaleVariance() const;
   bool usable() const { return config_.enabled && compared_ >= config_.min_distance; }
   double comparedDistance() const { return compared_; }
 

@@ -145,24 +145,39 @@ TEST(Start, AStartWhileMovingTakesItsSpeedAndYawRateFromTheOdometry) {
 namespace coloc::fusion {
 namespace {
 
-TEST(Integrity, AnchorsAppliedButFarOffAgainAndAgainMakeItLost) {
-  // The map matching holds the filter 25 cm off, the fixes (2 cm) just inside the gate each time.
+// Map matching that holds the filter `off` metres to the side, fixes (variance `fix_var`) at the truth.
+Localizer heldOff(double off, double fix_var, int fixes) {
   Localizer filter;
   const SourceId odom = filter.addTwistSource("odom"), ndt = filter.addPoseSource("ndt"), rsu = filter.addPoseSource("/rsu/a/fix", 0, true);
-  filter.initialize(testing::planarPose(testing::kStart, 0.0, 0.0, 0.0, 0.0225, 0.0001));
+  filter.initialize(testing::planarPose(testing::kStart, 0.0, off, 0.0, 0.0225, 0.0001));
   Stamp now = testing::kStart;
-  for (int i = 0; i < 12 && filter.integrity().state != LocalizationState::kLost; ++i) {
+  for (int i = 0; i < fixes && filter.integrity().state != LocalizationState::kLost; ++i) {
     for (int k = 0; k < 5; ++k) {
       now += testing::kTick;
       filter.feedTwist(odom, testing::twist(now, 0.0, 0.0));
       filter.advanceTo(now);
     }
-    filter.feedPose(ndt, testing::planarPose(now, 0.0, 0.0, 0.0, 0.0004));
-    const Verdict v = filter.feedPose(rsu, testing::fix2d(now, 0.0, 0.25, 0.0004));
-    EXPECT_NE(v.reason, Reason::kGated) << "fix " << i;
+    filter.feedPose(ndt, testing::planarPose(now, 0.0, off, 0.0, 0.0004));
+    const Verdict v = filter.feedPose(rsu, testing::fix2d(now, 0.0, 0.0, fix_var));
+    EXPECT_NE(v.reason, Reason::kGated) << "fix " << i;  // each just inside the gate
   }
+  return filter;
+}
+
+TEST(Integrity, AnchorsAppliedButAMetreOffAgainAndAgainMakeItLost) {
+  const Localizer filter = heldOff(1.2, 0.06, 12);
   EXPECT_EQ(filter.integrity().state, LocalizationState::kLost);
   EXPECT_NE(filter.integrity().reason.find("on average"), std::string::npos) << filter.integrity().reason;
+}
+
+TEST(Integrity, AMiscalibratedRsusSmallDisagreementDegradesButNeverMakesItLost) {
+  // 25 cm off again and again, as an RSU whose survey is off tells it: the RSU may be the wrong one.
+  Localizer filter = heldOff(0.25, 0.0004, 12);
+  EXPECT_EQ(filter.integrity().state, LocalizationState::kDegraded);
+  EXPECT_EQ(filter.integrity().losses, 0u);
+  // The fixes pull the filter halfway (both sources 2 cm): each disagrees by about 12 cm, and the
+  // reported deviation covers that.
+  EXPECT_GE(std::sqrt(filter.estimate()->pose_covariance(1, 1)), 0.1);
 }
 
 }  // namespace

@@ -74,6 +74,10 @@ struct EkfConfig {
   int integrity_anchor_window = 5;
   /// Chi-square(2)'s 0.999 quantile: the mean of 5 consistent draws exceeds it with a chance of about 1e-10.
   double integrity_anchor_mean_nis = 13.8;
+  /// Lost only when the anchors' disagreement is at least this: below it an anchor's own error (a
+  /// miscalibrated RSU: 10-40 cm) could tell the same story, and the filter stays degraded, its
+  /// reported covariance covering the disagreement, instead of jumping to the anchor.
+  double integrity_lost_min_distance = 1.0;  ///< m
   /// Poses of any other source gated in a row that make the filter `degraded`. 0 = off.
   int integrity_degraded_after_gated = 5;
   /// Seconds without any pose applied (dead reckoning on the twist alone) that make it `degraded`. 0 = off.

@@ -20,6 +20,8 @@ struct IntegrityStatus {
   Stamp since = 0;                 ///< the filter's time when the state was entered
   std::uint64_t degradations = 0;  ///< times the state became degraded
   std::uint64_t losses = 0;        ///< times it became lost
+  /// A search of the map doubted the position (Localizer::doubt) and no anchor has confirmed it since.
+  bool doubted = false;
 };
 
 }  // namespace coloc::fusion

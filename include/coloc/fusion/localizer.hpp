@@ -71,6 +71,10 @@ class Localizer {
   void reset();
   /// The filter's state and its reason, as the estimate carries it.
   const IntegrityStatus& integrity() const;
+  /// Tells the filter that another part of the system (a search of the map around a pose given by
+  /// hand) doubts its position by `offset` (m, x and y): it becomes degraded, with `reason`, and its
+  /// reported covariance covers the offset until an anchor's pose agrees with it.
+  void doubt(const std::string& reason, const Eigen::Vector2d& offset);
 
   Verdict feedPose(SourceId source, const PoseMeasurement& measurement);
   Verdict feedPose(std::string_view source, const PoseMeasurement& measurement);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "coloc/core/types.hpp"
 #include "coloc/ndt/aligner.hpp"
@@ -34,7 +35,7 @@ struct NdtPoseSourceCounters {
   std::uint64_t max_iterations = 0;
   std::uint64_t oscillation = 0;
   std::uint64_t low_score = 0;
-  std::uint64_t heading_searches = 0;  ///< scans matched from many headings (searchHeading)
+  std::uint64_t searches = 0;  ///< scans matched from many starting poses (searchHeading, searchAround); a heading search's scan counts among `scans` too
   double align_ms_total = 0.0;
 };
 
@@ -74,6 +75,12 @@ class NdtPoseSource {
   /// the scan matched from every candidate heading, the accepted match with the best NVTL kept (one
   /// scan in the counters). Never throws for bad scans: the outcome says what happened.
   ScanOutcome searchHeading(const PointCloud& scan, Stamp stamp, const Eigen::Vector2d& position, const HeadingSearch& search);
+  /// Whether the map matches better away from a pose given by hand: the scan matched from the pose and
+  /// from offsets on rings of `radii` (m) in `directions` directions, the best accepted match by NVTL
+  /// returned (a search, not a scan, in the counters: the scan is matched as usual too); `at_pose`
+  /// gets the match from the pose itself.
+  ScanOutcome searchAround(const PointCloud& scan, Stamp stamp, const Pose& around, const std::vector<double>& radii, int directions, double vx,
+                           ScanOutcome& at_pose);
 
   const NdtPoseSourceCounters& counters() const { return counters_; }
   const DynamicMap& map() const { return map_; }
@@ -83,6 +90,11 @@ class NdtPoseSource {
   ScanOutcome process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& predicted, double vx, double wz);
   ScanOutcome match(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz, const NdtTarget& target) const;
   void count(const ScanOutcome& out);
+  /// The scan preprocessed once and matched from each base pose (the first also reported in `first`),
+  /// the best accepted match by NVTL kept; the map is moved to `near`. `as_scan`: counted as one of
+  /// this source's scans (a heading search's), else as a search only (the scan is matched as usual too).
+  ScanOutcome matchFromEach(const PointCloud& scan, Stamp stamp, const Eigen::Vector2d& near, double vx, const std::vector<Eigen::Matrix4d>& bases,
+                            ScanOutcome* first, bool as_scan);
   /// The vehicle's pose from an accepted alignment of the LiDAR: map_T_base = map_T_lidar * lidar_T_base.
   void producePose(ScanOutcome& out, Stamp stamp) const;
 

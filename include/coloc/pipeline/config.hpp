@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "coloc/core/types.hpp"
 #include "coloc/fusion/ekf_config.hpp"
@@ -84,6 +85,20 @@ struct PipelineSection {
   /// Starts the filter here (x, y, z [m], yaw [rad]) at the first input, for runs whose only pose
   /// source is NDT, which needs a first guess.
   std::optional<Eigen::Vector4d> initial_pose;
+  /// A pose given by hand (initial_pose, /initialpose) is held against the map at the next scan (and
+  /// every start_check_interval until an RSU's fix agrees): NDT
+  /// also starts from rings of these radii around it (8 directions each), and a match better by
+  /// start_check_margin in NVTL more than 1 m away makes the filter degraded until an RSU agrees.
+  /// Empty: no check.
+  std::vector<double> start_check_radii = {2.0, 4.0, 6.0};  ///< m
+  double start_check_margin = 0.05;                          ///< NVTL
+  /// The check is made again this often until an RSU's fix agrees with the filter: where the scene
+  /// cannot tell (a corridor) at the start, it may later.
+  double start_check_interval = 2.0;                         ///< s
+  /// ... for this long after the start: a wrong start shows within seconds, while over a whole drive
+  /// without an RSU, places where another stretch of road matches better would be found by chance
+  /// (site C, NDT only: one at 18 s, 3.8 m away, NVTL 2.84 against 2.59).
+  double start_check_duration = 10.0;                        ///< s
   /// Learn the odometry's speed scale from NDT's poses and correct twists by it before the filter.
   bool speed_scale_estimation = true;
   double speed_scale_memory = 500.0;  ///< m of travel over which old comparisons fade

@@ -68,6 +68,7 @@ struct PipelineReport {
   std::vector<std::string> recovery_reasons; ///< the first few
   std::uint64_t degradations = 0, losses = 0;
   std::uint64_t clock_resets = 0;            ///< the clock went back and the filter started again
+  std::uint64_t start_checks = 0;            ///< poses given by hand held against the map (pipeline.start_check_radii)
   std::uint64_t inputs_dropped_by_reset = 0; ///< inputs that arrived before a jump back, dropped by it
   std::uint64_t events = 0;                  ///< starts, recoveries, state changes, clock resets
   std::vector<std::string> first_events;     ///< the first few, as one line each
