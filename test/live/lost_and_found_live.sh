@@ -77,7 +77,11 @@ awk -v w="$worst" -v m="$mean" -v r="$reference" 'BEGIN { exit !(w < 0.3 && m <=
 localize side "$work/sim/side.yaml"
 read -r _ span mean worst samples < <(passes "$work/live_side/fused.tum" 4)
 echo "initial pose 5 m off: from 4 s on mean ${mean} m, worst ${worst} m; $(grep -c 'event: .*recovered' "$work/localize_side.txt") recoveries said"
-[ "$(json "$work/live_side/summary.json" recoveries)" -ge 1 ] || { echo "FAIL: no recovery"; exit 1; }
+# It must have known: the map check doubts the start, or the RSU's fixes make it lost (then it recovers).
+# Whether the fixes pull it back through the filter or by a recovery depends on how many NDT poses the
+# filter took before the first fix (a slow machine: few, and the start's 1 m^2 lets the fixes in).
+noticed=$(( $(json "$work/live_side/summary.json" degradations) + $(json "$work/live_side/summary.json" losses) ))
+[ "$noticed" -ge 1 ] || { echo "FAIL: 5 m off and never degraded or lost"; exit 1; }
 awk -v w="$worst" -v n="$samples" 'BEGIN { exit !(n >= 300 && w < 0.3) }' || { echo "FAIL: ${worst} m off after the RSU's fixes ($samples estimates)"; exit 1; }
 
 # 3. Three passes of a looped log.
