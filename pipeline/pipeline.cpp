@@ -5,7 +5,6 @@
 #include <cmath>
 #include <condition_variable>
 #include <deque>
-#include <set>
 #include <sstream>
 #include <thread>
 #include <variant>
@@ -160,7 +159,6 @@ struct Pipeline::Impl {
   std::unique_ptr<ndt::NdtPoseSource> ndt;
   std::mutex ndt_use;  // live: the NDT thread's matching and the pipeline's heading search take turns
   fusion::SourceId ndt_id = -1;
-  std::set<fusion::SourceId> anchors;  // the RSUs' fix sources
   Initializer initializer;
   // A start given by hand is held against the map at the next scan and every start_check_interval
   // after, until an RSU's fix agrees with the filter.
@@ -232,7 +230,7 @@ struct Pipeline::Impl {
     if (options.registry) {
       checker.emplace(std::move(*options.registry), config.rsu.checks);
       for (const rsu_client::RsuInfo& rsu : checker->registry().rsus())
-        anchors.insert(fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose, config.rsu.smoothing_steps, true));
+        fix_sources[rsu.id] = addSource(rsu_client::fixTopic(rsu.id), fusion::SourceKind::kPose, config.rsu.smoothing_steps, true);  // anchors
     }
   }
 
@@ -268,7 +266,7 @@ struct Pipeline::Impl {
       event(formatSeconds(s.since) + " " + toString(s.state) + (s.reason.empty() ? std::string() : ": " + s.reason));
   }
 
-  // A pose to start from; with `hint` (a lost filter's heading) a recovery.
+  // Starts (or restarts) the filter from a pose the initializer found, saying how and why.
   void start(const StartPose& start, const std::string& why) {
     localizer.initialize(start.pose, initializer.twist());
     if (!localizer.initialized()) return;
@@ -277,6 +275,17 @@ struct Pipeline::Impl {
     report.started_how = start.how;
     event(formatSeconds(start.pose.stamp) + " " + why + ": " + start.how);
     emit(*localizer.estimate());
+  }
+
+  // A start from a pose given by hand: counted and said, and held against the map from the next scan.
+  void startedByHand(const std::string& how, Stamp stamp) {
+    ++report.starts;
+    report.started_how = how;
+    check_start = true;
+    next_start_check = 0;
+    last_state = fusion::LocalizationState::kLocalized;
+    noteState();
+    event(formatSeconds(stamp) + " started: " + how);
   }
 
   void tryStart() {
@@ -506,15 +515,8 @@ struct Pipeline::Impl {
       if (lost()) tryRecover();
     } else {
       const PoseMeasurement& pose = std::get<InitialPoseInput>(input).pose;
-      localizer.initialize(pose);
-      if (localizer.initialized()) {
-        ++report.starts;
-        check_start = true;
-        next_start_check = 0;
-        report.started_how = "initial pose";
-        last_state = fusion::LocalizationState::kLocalized;
-        noteState();
-        event(formatSeconds(pose.stamp) + " started: initial pose");
+      if (localizer.initialize(pose).applied()) {
+        startedByHand("initial pose", pose.stamp);
         emit(*localizer.estimate());
       }
     }
@@ -528,16 +530,9 @@ struct Pipeline::Impl {
       auto& [arrival, input] = *item;
       if (!first_input_seen) {
         first_input_seen = true;
-        if (config.pipeline.initial_pose && !localizer.initialized()) {
-          localizer.initialize(initialPose(*config.pipeline.initial_pose, stampOf(input)));
-          if (localizer.initialized()) {
-            ++report.starts;
-            check_start = true;
-            next_start_check = 0;
-            report.started_how = "pipeline.initial_pose";
-            event(formatSeconds(stampOf(input)) + " started: pipeline.initial_pose");
-          }
-        }
+        if (config.pipeline.initial_pose && !localizer.initialized() &&
+            localizer.initialize(initialPose(*config.pipeline.initial_pose, stampOf(input))).applied())
+          startedByHand("pipeline.initial_pose", stampOf(input));
       }
       runTo(arrival);
       apply(input, arrival);
