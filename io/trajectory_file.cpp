@@ -107,6 +107,39 @@ void writeTumTrajectory(std::ostream& out, const std::vector<TrajectoryPoint>& p
   }
 }
 
+struct TumWriter::Impl {
+  std::ofstream out;
+};
+
+TumWriter::TumWriter(const std::string& path, const std::string& comment, std::size_t flush_every)
+    : impl_(std::make_unique<Impl>()), path_(path), flush_every_(std::max<std::size_t>(1, flush_every)) {
+  impl_->out.open(path, std::ios::binary | std::ios::trunc);
+  if (!impl_->out) throw Error(path + ": cannot create the trajectory file");
+  writeTumTrajectory(impl_->out, {}, comment);
+  impl_->out.flush();
+}
+
+TumWriter::~TumWriter() {
+  try {
+    close();
+  } catch (const std::exception&) {
+    // A destructor cannot report it; close() called before does.
+  }
+}
+
+void TumWriter::append(const TrajectoryPoint& point) {
+  if (!impl_->out.is_open()) throw Error(path_ + ": the trajectory file is closed");
+  writeTumTrajectory(impl_->out, {point});
+  if (++points_ % flush_every_ == 0) impl_->out.flush();
+  if (!impl_->out) throw Error(path_ + ": writing the trajectory file failed");
+}
+
+void TumWriter::close() {
+  if (!impl_->out.is_open()) return;
+  impl_->out.close();
+  if (!impl_->out) throw Error(path_ + ": writing the trajectory file failed");
+}
+
 void writeTumTrajectory(const std::string& path, const std::vector<TrajectoryPoint>& points,
                         const std::string& comment) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -1,5 +1,6 @@
 #include "coloc/live/live_localizer.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -33,7 +34,9 @@ struct LiveLocalizer::Impl {
 
   mutable std::mutex mutex;  // topics, trajectory
   std::vector<TopicStatus> topics;
-  std::vector<io::TrajectoryPoint> trajectory;
+  std::unique_ptr<io::TumWriter> trajectory;
+  Stamp trajectory_first = 0, trajectory_last = 0;
+  std::string trajectory_error;
   std::atomic<std::uint64_t> published{0};
 
   std::unique_ptr<pipeline::Pipeline> pipe;
@@ -55,7 +58,10 @@ struct LiveLocalizer::Impl {
     const Stamp arrival = now();
     {
       std::lock_guard<std::mutex> lock(mutex);
-      ++topics[topic].received;
+      TopicStatus& t = topics[topic];
+      ++t.received;
+      if (t.last_arrival != 0 && arrival > t.last_arrival) t.longest_gap = std::max(t.longest_gap, toSeconds(arrival - t.last_arrival));
+      t.last_arrival = arrival;
     }
     if (stopped.load()) return;
     try {
@@ -69,7 +75,17 @@ struct LiveLocalizer::Impl {
   void publish(const fusion::Estimate& e) {
     {
       std::lock_guard<std::mutex> lock(mutex);
-      trajectory.push_back({e.stamp, e.pose});
+      if (trajectory) {
+        try {
+          trajectory->append({e.stamp, e.pose});
+          if (trajectory_first == 0) trajectory_first = e.stamp;
+          trajectory_last = e.stamp;
+        } catch (const std::exception& error) {
+          // A full disk must not stop the localizer: the file stops, and the status says why.
+          trajectory_error = error.what();
+          trajectory.reset();
+        }
+      }
     }
     if (stopped.load()) return;
     try {
@@ -99,6 +115,8 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
   Impl& d = *impl_;
   d.config = options.config;
   d.use_sim_time = options.use_sim_time;
+  if (!options.trajectory_file.empty())
+    d.trajectory = std::make_unique<io::TumWriter>(options.trajectory_file, "coloc fused trajectory (live)\nt x y z qx qy qz qw (t: header-stamp clock, s)");
   if (!options.registry && !d.config.rsu.registry.empty()) options.registry = rsu_client::RsuRegistry::load(d.config.rsu.registry);
   std::vector<std::string> rsu_ids;
   if (options.registry)
@@ -193,6 +211,14 @@ LiveLocalizer::~LiveLocalizer() {
 void LiveLocalizer::stop() {
   impl_->pipe->stop();
   impl_->stopped = true;
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (impl_->trajectory) {
+    try {
+      impl_->trajectory->close();
+    } catch (const std::exception& error) {
+      impl_->trajectory_error = error.what();
+    }
+  }
 }
 
 LiveStatus LiveLocalizer::status() const {
@@ -201,35 +227,52 @@ LiveStatus LiveLocalizer::status() const {
   s.estimate = impl_->pipe->estimate();
   s.published = impl_->published.load();
   s.clock = impl_->now();
-  s.matched_writers = impl_->node ? impl_->node->matchedWriters() : 0;
+  std::vector<rsu_client::DdsNode::ReaderStatus> readers;
+  if (impl_->node) readers = impl_->node->readers();
   std::lock_guard<std::mutex> lock(impl_->mutex);
   s.topics = impl_->topics;
+  // One reader per topic, subscribed in the order the topics were added.
+  for (std::size_t i = 0; i < s.topics.size() && i < readers.size(); ++i) {
+    TopicStatus& t = s.topics[i];
+    t.matched_writers = readers[i].matched_writers;
+    t.sequence_gaps = readers[i].sequence_gaps;
+    t.lost = readers[i].lost;
+    t.rejected = readers[i].rejected;
+    s.matched_writers += readers[i].matched_writers;
+  }
+  s.trajectory_points = impl_->trajectory ? impl_->trajectory->points() : 0;
+  s.trajectory_first = impl_->trajectory_first;
+  s.trajectory_last = impl_->trajectory_last;
+  s.trajectory_error = impl_->trajectory_error;
   return s;
-}
-
-std::vector<io::TrajectoryPoint> LiveLocalizer::trajectory() const {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
-  return impl_->trajectory;
 }
 
 std::string LiveLocalizer::summaryJson() const {
   const LiveStatus s = status();
-  const std::vector<io::TrajectoryPoint> fused = trajectory();
   nlohmann::ordered_json j;
   j["mode"] = "live";
   j["clock"] = impl_->use_sim_time ? "/clock (simulation time)" : "system";
   auto& topics = j["topics"] = nlohmann::ordered_json::array();
   for (const TopicStatus& t : s.topics) {
-    nlohmann::ordered_json o = {{"topic", t.topic}, {"type", t.type}, {"messages", t.received}, {"decode_errors", t.undecodable}};
+    nlohmann::ordered_json o = {{"topic", t.topic},
+                                {"type", t.type},
+                                {"messages", t.received},
+                                {"decode_errors", t.undecodable},
+                                {"matched_writers", t.matched_writers},
+                                {"sequence_gaps", t.sequence_gaps},
+                                {"dds_lost", t.lost},
+                                {"dds_rejected", t.rejected},
+                                {"longest_gap_s", t.longest_gap}};
     if (!t.first_error.empty()) o["first_error"] = t.first_error;
     topics.push_back(o);
   }
   j["sources"] = nlohmann::ordered_json::parse(pipeline::sourcesJson(s.report.sources));
   j["fused"] = {{"file", "fused.tum"},
-                {"poses", fused.size()},
+                {"poses", s.trajectory_points},
                 {"published", s.published},
-                {"first_stamp", formatSeconds(fused.empty() ? 0 : fused.front().stamp)},
-                {"last_stamp", formatSeconds(fused.empty() ? 0 : fused.back().stamp)}};
+                {"first_stamp", formatSeconds(s.trajectory_first)},
+                {"last_stamp", formatSeconds(s.trajectory_last)}};
+  if (!s.trajectory_error.empty()) j["fused"]["error"] = s.trajectory_error;
   if (s.report.ndt_used) {
     j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(s.report.ndt, s.report.map, s.report.scans_without_guess));
     j["ndt"]["scans_superseded"] = s.report.scans_superseded;

@@ -13,6 +13,7 @@
 #include <fastdds/dds/topic/TopicDataType.hpp>
 
 #include <atomic>
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -117,13 +118,21 @@ bool DdsNode::Writer::write(const std::vector<std::uint8_t>& bytes) {
 int DdsNode::Writer::matchedReaders() const { return impl_ ? impl_->listener.matched.load() : 0; }
 
 struct DdsNode::Impl : public dds::DataReaderListener {
+  // One subscribed reader: its callback and what it has seen. The counters are written on DDS threads
+  // and read by readers(), under `mutex`.
+  struct Reader {
+    ReaderStatus status;
+    Callback callback;
+    // The last sequence number taken from each matched writer (by its GUID), forgotten when it unmatches.
+    std::map<eprosima::fastrtps::rtps::GUID_t, std::int64_t> last_sequence;
+  };
   std::map<std::string, dds::TypeSupport> types;  // by DDS type name
-  std::map<dds::DataReader*, Callback> callbacks;
+  std::map<dds::DataReader*, Reader> readers;
+  std::vector<dds::DataReader*> order;  // subscribe() order
   std::vector<std::shared_ptr<Writer::Impl>> writers;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
-  std::atomic<int> matched{0};
-  std::mutex mutex;  // setup against the listener
+  mutable std::mutex mutex;  // setup and counters against the listener
 
   dds::Topic* topic(const std::string& ros_topic, const std::string& ros_type) {
     const std::string type_name = ddsTypeName(ros_type);
@@ -135,23 +144,52 @@ struct DdsNode::Impl : public dds::DataReaderListener {
     return t;
   }
 
+  Reader* find(dds::DataReader* reader) {
+    const auto found = readers.find(reader);
+    return found == readers.end() ? nullptr : &found->second;
+  }
+
   void on_data_available(dds::DataReader* reader) override {
     Callback* callback = nullptr;
     {
       std::lock_guard<std::mutex> lock(mutex);
-      const auto found = callbacks.find(reader);
-      if (found != callbacks.end()) callback = &found->second;
+      if (Reader* r = find(reader)) callback = &r->callback;
     }
     Bytes bytes;
     dds::SampleInfo info;
     while (reader->take_next_sample(&bytes, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || !callback) continue;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        Reader& r = readers.at(reader);
+        ++r.status.samples;
+        const auto& id = info.sample_identity;
+        const std::int64_t sequence = static_cast<std::int64_t>(id.sequence_number().to64long());
+        auto [last, first] = r.last_sequence.emplace(id.writer_guid(), sequence);
+        // Samples written before this reader matched are no loss: counting starts at the first taken.
+        if (!first) {
+          if (sequence > last->second + 1) r.status.sequence_gaps += static_cast<std::uint64_t>(sequence - last->second - 1);
+          last->second = std::max(last->second, sequence);
+        }
+      }
       (*callback)(std::move(bytes), systemNow());
       bytes = Bytes();
     }
   }
-  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
-    matched += status.current_count_change;
+  void on_subscription_matched(dds::DataReader* reader, const dds::SubscriptionMatchedStatus& status) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (Reader* r = find(reader)) {
+      r->status.matched_writers = status.current_count;
+      if (status.current_count_change < 0) r->last_sequence.erase(eprosima::fastrtps::rtps::iHandle2GUID(status.last_publication_handle));
+    }
+  }
+  void on_sample_lost(dds::DataReader* reader, const dds::SampleLostStatus& status) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (Reader* r = find(reader)) r->status.lost += static_cast<std::uint64_t>(std::max(0, status.total_count_change));
+  }
+  void on_sample_rejected(dds::DataReader* reader, const dds::SampleRejectedStatus& status) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (Reader* r = find(reader)) r->status.rejected += status.total_count_change;
   }
   OwnedParticipant participant;  // last member: deleted first, while listeners still exist
 };
@@ -182,10 +220,31 @@ void DdsNode::subscribe(const std::string& ros_topic, const std::string& ros_typ
   // Created without a listener, registered, then given one: no sample can reach an unknown reader.
   dds::DataReader* reader = impl_->subscriber->create_datareader(topic, applied(dds::DATAREADER_QOS_DEFAULT, qos), nullptr);
   if (!reader) throw Error("DDS: cannot subscribe to " + ddsTopicName(ros_topic));
-  impl_->callbacks.emplace(reader, std::move(callback));
+  Impl::Reader r;
+  r.status.topic = ros_topic;
+  r.status.type = ros_type;
+  r.callback = std::move(callback);
+  impl_->readers.emplace(reader, std::move(r));
+  impl_->order.push_back(reader);
   reader->set_listener(impl_.get());
+  // A writer may have matched before the listener was set: take the count as it stands.
+  dds::SubscriptionMatchedStatus matched;
+  if (reader->get_subscription_matched_status(matched) == ReturnCode_t::RETCODE_OK && matched.current_count > 0)
+    impl_->readers.at(reader).status.matched_writers = matched.current_count;
 }
 
-int DdsNode::matchedWriters() const { return impl_->matched.load(); }
+int DdsNode::matchedWriters() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  int n = 0;
+  for (const auto& [reader, r] : impl_->readers) n += r.status.matched_writers;
+  return n;
+}
+
+std::vector<DdsNode::ReaderStatus> DdsNode::readers() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::vector<ReaderStatus> out;
+  for (dds::DataReader* r : impl_->order) out.push_back(impl_->readers.at(r).status);
+  return out;
+}
 
 }  // namespace coloc::rsu_client

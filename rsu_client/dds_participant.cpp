@@ -4,6 +4,7 @@
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include <filesystem>
@@ -46,14 +47,23 @@ dds::DomainParticipant* createParticipant(const DdsConfig& config) {
   // ROS 2 announces its enclave in the participant's user data; tools such as `ros2 node list` read it.
   const std::string enclave = "enclave=/;";
   qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(enclave.begin(), enclave.end()));
+  // The transports are given explicitly rather than Fast DDS's built-in ones, so that their buffers fit
+  // point clouds (DdsConfig); they are the same kinds: shared memory on the host, UDP beyond it.
+  qos.transport().use_builtin_transports = false;
+  if (config.shared_memory) {
+    auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
+    shm->segment_size(config.shm_segment_bytes);
+    qos.transport().user_transports.push_back(shm);
+  }
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->sendBufferSize = config.socket_buffer_bytes;
+  udp->receiveBufferSize = config.socket_buffer_bytes;
+  qos.transport().user_transports.push_back(udp);
   if (config.loopback_only) {
     // Only loopback, and discovery by unicast to the peers on it: nothing leaves the machine, and it
-    // works where shared memory between containers does not.
-    qos.transport().use_builtin_transports = false;
-    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    // works where multicast does not.
     udp->interfaceWhiteList.push_back("127.0.0.1");
     udp->maxInitialPeersRange = 32;  // Fast DDS reaches only 4 participants per peer by default
-    qos.transport().user_transports.push_back(udp);
     eprosima::fastrtps::rtps::Locator_t peer;
     eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, 127, 0, 0, 1);
     qos.wire_protocol().builtin.initialPeersList.push_back(peer);

@@ -11,6 +11,8 @@ void addDdsOptions(CLI::App* cmd, DdsOptions& o) {
                                  "UDP on 127.0.0.1 only, unicast discovery: nothing leaves the machine (also ROS_LOCALHOST_ONLY=1); "
                                  "default: Fast DDS's defaults as a ROS 2 node uses them (multicast discovery on every interface, shared memory)");
   cmd->add_flag("--any-interface", o.any_interface, "every interface even when ROS_LOCALHOST_ONLY=1")->excludes(loopback);
+  cmd->add_flag("--no-shared-memory", o.no_shared_memory,
+                "UDP only, no shared memory between processes of this host (containers that share the network but not /dev/shm)");
   cmd->add_option("--security", o.security_dir,
                   "folder with DDS Security files: identity_ca.pem, permissions_ca.pem, governance.p7s, NAME.pem, "
                   "NAME_key.pem, NAME_permissions.p7s (NAME: --name)");
@@ -22,6 +24,7 @@ rsu_client::DdsConfig ddsConfig(const DdsOptions& o, const std::string& default_
   c.reliable = o.reliable;
   if (o.loopback_only) c.loopback_only = true;
   if (o.any_interface) c.loopback_only = false;
+  if (o.no_shared_memory) c.shared_memory = false;
   c.participant_name = o.name.empty() ? default_name : o.name;
   if (!o.security_dir.empty()) {
     const std::string d = o.security_dir + "/", n = c.participant_name;

@@ -13,6 +13,7 @@ struct DdsOptions {
   bool reliable = false;
   bool loopback_only = false;  ///< also when ROS_LOCALHOST_ONLY=1
   bool any_interface = false;  ///< overrides ROS_LOCALHOST_ONLY=1
+  bool no_shared_memory = false;
   std::string security_dir;  ///< folder with identity_ca.pem, <name>.pem, <name>_key.pem, governance.p7s, <name>_permissions.p7s
   std::string name;
 };

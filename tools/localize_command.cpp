@@ -45,8 +45,23 @@ void printStatus(const live::LiveStatus& s, double elapsed) {
                                                                     : s.report.state_reason.c_str());
   }
   std::printf(" | published %llu", (unsigned long long)s.published);
-  if (s.report.ndt_used)
-    std::printf(" | ndt %llu/%llu", (unsigned long long)s.report.ndt.poses, (unsigned long long)s.report.ndt.scans);
+  if (s.report.ndt_used) {
+    // Scans NDT never matched: replaced by a newer one while it was busy, or with no guess to start from.
+    std::printf(" | ndt %llu poses of %llu scans", (unsigned long long)s.report.ndt.poses, (unsigned long long)s.report.ndt.scans);
+    if (s.report.scans_superseded) std::printf(", %llu skipped (busy)", (unsigned long long)s.report.scans_superseded);
+    if (s.report.scans_without_guess) std::printf(", %llu before a guess", (unsigned long long)s.report.scans_without_guess);
+  }
+  // What the transport lost, and the inputs that fell silent (more than 1 s since their last message).
+  std::uint64_t lost = 0;
+  for (const auto& t : s.topics) lost += t.sequence_gaps + t.rejected;
+  if (lost) {
+    std::printf(" | LOST");
+    for (const auto& t : s.topics)
+      if (t.sequence_gaps + t.rejected) std::printf(" %s %llu", t.topic.c_str(), (unsigned long long)(t.sequence_gaps + t.rejected));
+  }
+  for (const auto& t : s.topics)
+    if (t.last_arrival != 0 && s.clock > t.last_arrival && toSeconds(s.clock - t.last_arrival) > 1.0 && t.topic != "/clock")
+      std::printf(" | %s silent %.1f s", t.topic.c_str(), toSeconds(s.clock - t.last_arrival));
   if (!s.report.fixes.empty()) {
     std::uint64_t received = 0, refused = 0;
     for (const auto& [id, c] : s.report.fixes) received += c.received, refused += c.received - c.passed_checks;
@@ -57,7 +72,9 @@ void printStatus(const live::LiveStatus& s, double elapsed) {
   }
   if (s.report.recoveries || s.report.clock_resets)
     std::printf(" | recoveries %llu, clock resets %llu", (unsigned long long)s.report.recoveries, (unsigned long long)s.report.clock_resets);
-  std::printf(" | rejected %llu | writers %d\n", (unsigned long long)s.report.rejections, s.matched_writers);
+  std::printf(" | rejected %llu | writers %d", (unsigned long long)s.report.rejections, s.matched_writers);
+  if (!s.trajectory_error.empty()) std::printf(" | fused.tum stopped: %s", s.trajectory_error.c_str());
+  std::printf("\n");
   std::fflush(stdout);
 }
 
@@ -88,14 +105,15 @@ void addLocalizeCommand(CLI::App& app) {
     options.use_sim_time = sim_time;
     options.dds = ddsConfig(dds, "coloc_localizer");
     // Starts, recoveries, state changes and clock resets, as they happen.
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
+    options.trajectory_file = out_dir + "/fused.tum";
     options.on_event = [](const std::string& line) {
       std::printf("event: %s\n", line.c_str());
       std::fflush(stdout);
     };
     printSecurity(options.dds);
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec) throw Error(out_dir + ": cannot create the output folder: " + ec.message());
     std::signal(SIGINT, requestStop);
     std::signal(SIGTERM, requestStop);
 
@@ -130,15 +148,16 @@ void addLocalizeCommand(CLI::App& app) {
       if (idle > 0.0 && inputs_seen > 0 && std::chrono::duration<double>(now - last_input).count() >= idle) break;
     }
     localizer.stop();
-    io::writeTumTrajectory(out_dir + "/fused.tum", localizer.trajectory(),
-                           "coloc fused trajectory (live)\nt x y z qx qy qz qw (t: header-stamp clock, s)");
     std::ofstream(out_dir + "/summary.json") << localizer.summaryJson();
     const live::LiveStatus s = localizer.status();
-    std::printf("stopped%s: %zu estimates written to %s/fused.tum; summary.json beside it\n", g_stop.load() ? " on a signal" : "",
-                localizer.trajectory().size(), out_dir.c_str());
+    std::printf("stopped%s: %llu estimates written to %s/fused.tum; summary.json beside it\n", g_stop.load() ? " on a signal" : "",
+                (unsigned long long)s.trajectory_points, out_dir.c_str());
+    if (!s.trajectory_error.empty()) std::printf("  fused.tum stopped early: %s\n", s.trajectory_error.c_str());
     for (const auto& t : s.topics)
-      std::printf("  %-48s %8llu messages %6llu undecodable%s%s\n", t.topic.c_str(), (unsigned long long)t.received,
-                  (unsigned long long)t.undecodable, t.first_error.empty() ? "" : "  first: ", t.first_error.c_str());
+      std::printf("  %-48s %8llu messages %6llu undecodable %6llu lost (%llu gaps, %llu rejected)  longest gap %.2f s%s%s\n", t.topic.c_str(),
+                  (unsigned long long)t.received, (unsigned long long)t.undecodable, (unsigned long long)(t.sequence_gaps + t.rejected),
+                  (unsigned long long)t.sequence_gaps, (unsigned long long)t.rejected, t.longest_gap, t.first_error.empty() ? "" : "  first: ",
+                  t.first_error.c_str());
     for (const auto& [id, c] : s.report.fixes) std::printf("  %s\n", fixLine(id, s.report).c_str());
     std::printf("  localization: %s\n", localizationLine(s.report).c_str());
     for (const auto& line : s.report.first_rejections) std::printf("  rejected: %s\n", line.c_str());

@@ -45,6 +45,23 @@ TEST(TrajectoryFile, WriteThenReadKeepsStampsExactToTheNanosecond) {
   }
 }
 
+TEST(TrajectoryFile, AStreamedFileHoldsWhatWasAppendedAndIsReadableBeforeItIsClosed) {
+  ScratchDir dir;
+  std::vector<TrajectoryPoint> points;
+  for (int i = 0; i < 7; ++i) points.push_back(point(1'700'000'000'000'000'000LL + i * 20'000'000LL, 0.5 * i, -0.1 * i, 0.01 * i));
+  TumWriter writer(dir / "live.tum", "coloc fused trajectory (live)", 3);
+  for (const auto& p : points) writer.append(p);
+  // Flushed every third point: a reader (or a crash) sees at least the first six.
+  EXPECT_GE(readTumTrajectory(dir / "live.tum").size(), 6u);
+  writer.close();
+  const std::vector<TrajectoryPoint> read = readTumTrajectory(dir / "live.tum");
+  ASSERT_EQ(read.size(), points.size());
+  EXPECT_EQ(writer.points(), points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) EXPECT_EQ(read[i].stamp, points[i].stamp);
+  EXPECT_NE(errorMessage([&] { writer.append(points[0]); }).find("closed"), std::string::npos);
+  EXPECT_NE(errorMessage([&] { TumWriter(dir / "no_such_folder/x.tum"); }).find("cannot create"), std::string::npos);
+}
+
 TEST(TrajectoryFile, ReadingAcceptsCommentsBlankLinesTabsAndWindowsLineEnds) {
   std::istringstream in(
       "# timestamp tx ty tz qx qy qz qw\n"

@@ -1,7 +1,9 @@
 // Publisher and subscriber in one process, over UDP on loopback, with the ROS 2 names and types.
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstring>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -125,6 +127,63 @@ TEST(DdsLoopback, VehicleDimensionsReachTheRsu) {
   EXPECT_EQ(seen.length, 4.8);
   EXPECT_EQ(seen.width, 1.9);
   EXPECT_EQ(seen.reference_x, 1.2);
+}
+
+// Large best-effort samples through UDP with small socket buffers and no shared memory: fragments are
+// dropped. Whatever did not arrive between the first and the last sample taken must be counted as a
+// gap in the writer's sequence numbers, exactly.
+TEST(DdsLoopback, EverySampleLostBetweenTwoTakenIsCountedAsASequenceGap) {
+  // Two participants of one process would otherwise hand samples over in memory, losing none.
+  using eprosima::fastrtps::xmlparser::XMLProfileManager;
+  const eprosima::fastrtps::LibrarySettingsAttributes before = XMLProfileManager::library_settings();
+  eprosima::fastrtps::LibrarySettingsAttributes off = before;
+  off.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  XMLProfileManager::library_settings(off);
+  struct Restore {
+    eprosima::fastrtps::LibrarySettingsAttributes settings;
+    ~Restore() { eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings); }
+  } restore{before};
+  DdsConfig config = testConfig(74);
+  config.shared_memory = false;
+  config.socket_buffer_bytes = 128 * 1024;
+  DdsNode reader_node(config), writer_node(config);
+  TopicQos qos;
+  qos.reliable = false;
+  qos.depth = 5;
+  std::mutex mutex;
+  std::vector<std::uint32_t> indices;  // of the samples taken, from their payload
+  reader_node.subscribe("/big", "sensor_msgs/msg/PointCloud2", qos, [&](std::vector<std::uint8_t>&& bytes, Stamp) {
+    std::uint32_t index = 0;
+    std::memcpy(&index, bytes.data() + 4, sizeof index);
+    std::lock_guard<std::mutex> lock(mutex);
+    indices.push_back(index);
+  });
+  DdsNode::Writer writer = writer_node.advertise("/big", "sensor_msgs/msg/PointCloud2", qos);
+  ASSERT_TRUE(waitUntil([&] { return writer.matchedReaders() == 1 && reader_node.readers()[0].matched_writers == 1; },
+                        std::chrono::seconds(10)));
+  const int kSamples = 60;
+  std::vector<std::uint8_t> sample(1 << 20, 0x5a);
+  sample[0] = 0, sample[1] = 1, sample[2] = 0, sample[3] = 0;
+  for (std::uint32_t i = 0; i < kSamples; ++i) {
+    std::memcpy(sample.data() + 4, &i, sizeof i);
+    writer.write(sample);
+  }
+  // The last sample is small and sent after a pause: it arrives, so every loss lies between two taken.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  std::vector<std::uint8_t> last(64, 0);
+  last[1] = 1;
+  const std::uint32_t final_index = kSamples;
+  std::memcpy(last.data() + 4, &final_index, sizeof final_index);
+  writer.write(last);
+  ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return !indices.empty() && indices.back() == final_index; },
+                        std::chrono::seconds(10)));
+  const DdsNode::ReaderStatus status = reader_node.readers()[0];
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_EQ(status.topic, "/big");
+  EXPECT_EQ(status.samples, indices.size());
+  const std::uint64_t span = indices.back() - indices.front() + 1;
+  EXPECT_EQ(status.sequence_gaps, span - indices.size()) << indices.size() << " of " << span << " samples taken";
+  EXPECT_LT(indices.size(), static_cast<std::size_t>(kSamples)) << "nothing was lost: the test no longer forces a loss";
 }
 
 TEST(DdsTopics, FollowTheRos2NamingRules) {

@@ -29,13 +29,22 @@ struct LiveOptions {
   bool use_sim_time = false;
   /// Starts, recoveries, state changes and clock resets, one line each, on the pipeline's thread.
   std::function<void(const std::string& line)> on_event;
+  /// Every published estimate is appended to this TUM file as it comes, so that hours of driving take
+  /// no memory; empty: none is written.
+  std::string trajectory_file;
 };
 
-/// What one subscribed topic brought.
+/// What one subscribed topic brought, and what it lost on the way as far as DDS can see.
 struct TopicStatus {
   std::string topic, type;
   std::uint64_t received = 0, undecodable = 0;
   std::string first_error;
+  int matched_writers = 0;
+  /// Samples its writers sent that never reached the node (gaps in each writer's sequence numbers),
+  /// and DDS's own sample-lost and sample-rejected counts.
+  std::uint64_t sequence_gaps = 0, lost = 0, rejected = 0;
+  Stamp last_arrival = 0;     ///< on the node's clock; 0: nothing yet
+  double longest_gap = 0.0;   ///< s, the longest time between two arrivals
 };
 
 struct LiveStatus {
@@ -45,6 +54,10 @@ struct LiveStatus {
   std::uint64_t published = 0;  ///< estimates published
   Stamp clock = 0;              ///< the node's time now
   int matched_writers = 0;      ///< remote writers matched with the node's readers
+  /// The fused trajectory as written so far (LiveOptions::trajectory_file).
+  std::uint64_t trajectory_points = 0;
+  Stamp trajectory_first = 0, trajectory_last = 0;
+  std::string trajectory_error;  ///< why writing it stopped, if it did
 };
 
 class LiveLocalizer {
@@ -58,8 +71,6 @@ class LiveLocalizer {
   /// Stops the pipeline (what arrived still counts); nothing is published afterwards.
   void stop();
   LiveStatus status() const;
-  /// Every estimate published so far, for fused.tum.
-  std::vector<io::TrajectoryPoint> trajectory() const;
   /// summary.json in the shape `coloc fuse` writes: topics, sources, NDT, fixes, rejections.
   std::string summaryJson() const;
 

@@ -60,6 +60,21 @@ class DdsNode {
   /// Remote writers currently matched with this node's readers, all topics together.
   int matchedWriters() const;
 
+  /// What one reader has seen, counted as DDS sees it: a loss anywhere between a writer's write and
+  /// this node's callback (a dropped fragment, a full socket or shared-memory buffer, a sample
+  /// replaced in a keep-last history before it was taken) shows as a gap in the writer's sequence
+  /// numbers.
+  struct ReaderStatus {
+    std::string topic, type;          ///< ROS names
+    int matched_writers = 0;
+    std::uint64_t samples = 0;        ///< taken with data, handed to the callback
+    std::uint64_t sequence_gaps = 0;  ///< samples a matched writer sent that never arrived
+    std::uint64_t lost = 0;           ///< DDS's sample-lost status
+    std::uint64_t rejected = 0;       ///< DDS's sample-rejected status (resource limits)
+  };
+  /// One entry per subscribe(), in order.
+  std::vector<ReaderStatus> readers() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
