@@ -2,14 +2,20 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <sstream>
+#include <thread>
 #include <mutex>
 #include <nlohmann/json.hpp>
 
 #include "coloc/core/error.hpp"
 #include "coloc/io/ros_messages.hpp"
+#include "coloc/io/ros_node_interfaces.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
 #include "coloc/pipeline/report_json.hpp"
 #include "coloc/rsu_client/dds_node.hpp"
+#include "diagnostics.hpp"
 
 namespace coloc::live {
 
@@ -41,7 +47,21 @@ struct LiveLocalizer::Impl {
 
   std::unique_ptr<pipeline::Pipeline> pipe;
   std::unique_ptr<rsu_client::DdsNode> node;  // after the pipeline: destroyed first, so no callback outlives it
-  rsu_client::DdsNode::Writer pose_writer, odometry_writer;
+  rsu_client::DdsNode::Writer pose_writer, odometry_writer, twist_writer, biased_pose_writer, pose_stamped_writer, ndt_pose_writer, tf_writer,
+      diagnostics_writer;
+
+  // Activation by the trigger services (Autoware's pose_initializer switches both off, aligns, gives
+  // the initial pose, switches both on). A service not served counts as on.
+  std::atomic<bool> ekf_active{true}, ndt_active{true};
+  bool activated() const { return ekf_active.load() && ndt_active.load(); }
+
+  // Alignment requests wait here for the worker: NDT's search takes longer than a DDS thread may be held.
+  std::mutex align_mutex;
+  std::condition_variable align_wake;
+  std::deque<std::pair<io::StampedPose, rsu_client::DdsNode::Respond>> align_queue;
+  std::thread align_worker, housekeeping;
+  std::atomic<bool> quit{false};
+  DiagnosticsMemory diagnostics_memory;
 
   Stamp now() const { return use_sim_time ? sim_now.load() : rsu_client::systemNow(); }
 
@@ -73,6 +93,7 @@ struct LiveLocalizer::Impl {
   }
 
   void publish(const fusion::Estimate& e) {
+    if (!activated()) return;  // Autoware's EKF publishes nothing until activated
     {
       std::lock_guard<std::mutex> lock(mutex);
       if (trajectory) {
@@ -104,9 +125,119 @@ struct LiveLocalizer::Impl {
       odom.twist.angular = e.angular_velocity;
       odom.twist.covariance = e.twist_covariance;
       odometry_writer.write(io::encodeOdometry(odom));
+      if (twist_writer.matchedReaders() > 0) {
+        io::StampedTwist twist;
+        twist.header = {e.stamp, config.live.child_frame_id};
+        twist.measurement = odom.twist;
+        twist_writer.write(io::encodeTwistWithCovarianceStamped(twist));
+      }
+      if (pose_stamped_writer.matchedReaders() > 0) pose_stamped_writer.write(io::encodePoseStamped(pose));
+      if (biased_pose_writer.matchedReaders() > 0) {
+        // The yaw as the pose sources measure it, before the filter's yaw bias: what NDT starts from.
+        io::StampedPose biased = pose;
+        const Eigen::Vector3d rpy = rollPitchYaw(e.pose.orientation);
+        biased.measurement.pose.orientation = quaternionFromRollPitchYaw(rpy[0], rpy[1], rpy[2] - e.yaw_bias);
+        biased_pose_writer.write(io::encodePoseWithCovarianceStamped(biased));
+      }
+      if (tf_writer.matchedReaders() > 0) {
+        io::TFMessage tf;
+        io::TransformStamped t;
+        t.header = {e.stamp, config.live.frame_id};
+        t.child_frame_id = config.live.child_frame_id;
+        t.translation = e.pose.position;
+        t.rotation = e.pose.orientation;
+        tf.transforms.push_back(t);
+        tf_writer.write(io::encodeTFMessage(tf));
+      }
       ++published;
     } catch (const std::exception&) {
       // An estimate that cannot be encoded (a stamp beyond int32 seconds) is kept in the trajectory only.
+    }
+  }
+
+  void publishNdtPose(const PoseMeasurement& pose) {
+    if (!activated() || ndt_pose_writer.matchedReaders() == 0) return;
+    try {
+      io::StampedPose out;
+      out.header = {pose.stamp, config.live.frame_id};
+      out.measurement = pose;
+      ndt_pose_writer.write(io::encodePoseWithCovarianceStamped(out));
+    } catch (const std::exception&) {
+      // not encodable: the filter has it all the same
+    }
+  }
+
+  // std_srvs/SetBool on a trigger service: true activates, false deactivates. The filter keeps running
+  // meanwhile, so that it is ready when activated; the initial pose that follows restarts it.
+  void serveTrigger(const std::string& service, std::atomic<bool>& flag) {
+    flag = config.live.start_activated;
+    node->serve(service, io::kSetBoolType, [this, &flag, service](Bytes&& request, rsu_client::DdsNode::Respond respond) {
+      io::SetBoolResponse response;
+      try {
+        const bool on = io::decodeSetBoolRequest(request.data(), request.size());
+        flag = on;
+        response.success = true;
+        response.message = on ? "activated" : "deactivated";
+        event(service + ": " + response.message);
+      } catch (const std::exception& e) {
+        response.message = e.what();
+      }
+      respond(io::encodeSetBoolResponse(response));
+    });
+  }
+
+  void event(const std::string& line) {
+    if (on_event) on_event(line);
+  }
+  std::function<void(const std::string&)> on_event;
+
+  void alignLoop() {
+    for (;;) {
+      std::pair<io::StampedPose, rsu_client::DdsNode::Respond> job;
+      {
+        std::unique_lock<std::mutex> lock(align_mutex);
+        align_wake.wait(lock, [this] { return quit.load() || !align_queue.empty(); });
+        if (quit.load()) return;
+        job = std::move(align_queue.front());
+        align_queue.pop_front();
+      }
+      io::PoseAlignResponse response;
+      response.pose = job.first;
+      const pipeline::AlignOutcome outcome = pipe->align(job.first.measurement.pose);
+      if (outcome.success) {
+        response.success = true;
+        response.reliable = outcome.reliable;
+        response.pose.measurement.pose = outcome.pose.pose;  // the request's covariance stays, as Autoware's NDT answers
+      }
+      std::ostringstream line;
+      line.precision(3);
+      line << config.live.align_service << ": " << (outcome.success ? "aligned" : "failed: " + outcome.why) << " from " << outcome.starts
+           << " starts";
+      if (outcome.success)
+        line << ", " << (outcome.pose.pose.position - job.first.measurement.pose.position).head<2>().norm() << " m from the request, NVTL "
+             << outcome.nvtl << (outcome.reliable ? " (reliable)" : " (not reliable)");
+      event(line.str());
+      try {
+        job.second(io::encodePoseAlignResponse(response));
+      } catch (const std::exception&) {
+        // a request stamped beyond int32 seconds: nothing can be answered
+      }
+    }
+  }
+
+  void housekeepingLoop(LiveLocalizer& self) {
+    const auto period = std::chrono::duration<double>(1.0 / config.live.diagnostics_frequency);
+    while (!quit.load()) {
+      std::this_thread::sleep_for(period);
+      if (quit.load()) return;
+      if (diagnostics_writer.matchedReaders() == 0) continue;
+      try {
+        const io::DiagnosticArray d =
+            diagnosticsOf(self.status(), activated(), now(), 1.0 / config.fusion.predict_frequency, diagnostics_memory);
+        diagnostics_writer.write(io::encodeDiagnosticArray(d));
+      } catch (const std::exception&) {
+        // a clock before the epoch: no diagnostics until it is sensible
+      }
     }
   }
 };
@@ -130,15 +261,50 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
   po.clock = [&d] { return d.now(); };
   d.pipe = std::make_unique<pipeline::Pipeline>(d.config, std::move(po));
   d.pipe->onEstimate([&d](const fusion::Estimate& e) { d.publish(e); });
+  d.on_event = options.on_event;
   if (options.on_event) d.pipe->onEvent(options.on_event);
+  d.pipe->onPoseInput([&d](const std::string& source, const PoseMeasurement& pose) {
+    if (source == pipeline::kNdtSource) d.publishNdtPose(pose);
+  });
   const fusion::SourceId twist_source = d.pipe->addTwistSource(d.config.live.twist_topic);
 
   d.node = std::make_unique<rsu_client::DdsNode>(options.dds);
   rsu_client::TopicQos out_qos;
   out_qos.reliable = true;  // as Autoware's EKF publishes: reliable readers and best-effort ones both match
   out_qos.depth = 10;
-  d.pose_writer = d.node->advertise(d.config.live.pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
-  d.odometry_writer = d.node->advertise(d.config.live.odometry_topic, "nav_msgs/msg/Odometry", out_qos);
+  auto advertise = [&](const std::string& topic, const char* type, const rsu_client::TopicQos& qos) {
+    return topic.empty() ? rsu_client::DdsNode::Writer() : d.node->advertise(topic, type, qos);
+  };
+  d.pose_writer = advertise(d.config.live.pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
+  d.odometry_writer = advertise(d.config.live.odometry_topic, "nav_msgs/msg/Odometry", out_qos);
+  d.twist_writer = advertise(d.config.live.twist_out_topic, "geometry_msgs/msg/TwistWithCovarianceStamped", out_qos);
+  d.biased_pose_writer = advertise(d.config.live.biased_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
+  d.pose_stamped_writer = advertise(d.config.live.pose_stamped_topic, "geometry_msgs/msg/PoseStamped", out_qos);
+  if (have_map) d.ndt_pose_writer = advertise(d.config.live.ndt_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
+  if (d.config.live.tf) {
+    rsu_client::TopicQos tf_qos = out_qos;
+    tf_qos.depth = 100;  // tf2_ros's broadcaster: reliable, volatile, keep last 100
+    d.tf_writer = d.node->advertise("/tf", "tf2_msgs/msg/TFMessage", tf_qos);
+  }
+  if (d.config.live.diagnostics) d.diagnostics_writer = d.node->advertise("/diagnostics", io::kDiagnosticArrayType, out_qos);
+  if (!d.config.live.ekf_trigger_service.empty()) d.serveTrigger(d.config.live.ekf_trigger_service, d.ekf_active);
+  if (!d.config.live.ndt_trigger_service.empty()) d.serveTrigger(d.config.live.ndt_trigger_service, d.ndt_active);
+  if (!d.config.live.align_service.empty()) {
+    d.node->serve(d.config.live.align_service, io::kPoseAlignServiceType, [&d](Bytes&& request, rsu_client::DdsNode::Respond respond) {
+      io::PoseAlignResponse refused;
+      try {
+        io::StampedPose pose = io::decodePoseAlignRequest(request.data(), request.size());
+        std::lock_guard<std::mutex> lock(d.align_mutex);
+        d.align_queue.emplace_back(std::move(pose), std::move(respond));
+        d.align_wake.notify_one();
+        return;
+      } catch (const std::exception& e) {
+        d.event(d.config.live.align_service + ": request refused: " + e.what());
+      }
+      respond(io::encodePoseAlignResponse(refused));
+    });
+    d.align_worker = std::thread([&d] { d.alignLoop(); });
+  }
 
   if (d.use_sim_time) {
     const std::size_t t = d.addTopic(io::kClockTopic, io::kClockType);
@@ -201,6 +367,7 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
       });
     }
   d.pipe->start();
+  d.housekeeping = std::thread([&d, this] { d.housekeepingLoop(*this); });
 }
 
 LiveLocalizer::~LiveLocalizer() {
@@ -209,6 +376,13 @@ LiveLocalizer::~LiveLocalizer() {
 }
 
 void LiveLocalizer::stop() {
+  {
+    std::lock_guard<std::mutex> lock(impl_->align_mutex);
+    impl_->quit = true;
+    impl_->align_wake.notify_all();
+  }
+  if (impl_->align_worker.joinable()) impl_->align_worker.join();
+  if (impl_->housekeeping.joinable()) impl_->housekeeping.join();
   impl_->pipe->stop();
   impl_->stopped = true;
   std::lock_guard<std::mutex> lock(impl_->mutex);
@@ -227,6 +401,7 @@ LiveStatus LiveLocalizer::status() const {
   s.estimate = impl_->pipe->estimate();
   s.published = impl_->published.load();
   s.clock = impl_->now();
+  s.activated = impl_->activated();
   std::vector<rsu_client::DdsNode::ReaderStatus> readers;
   if (impl_->node) readers = impl_->node->readers();
   std::lock_guard<std::mutex> lock(impl_->mutex);

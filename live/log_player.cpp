@@ -35,6 +35,11 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
     throw Error("play: the clock frequency must be a number of Hz in [1, 10000]");
   if (!(std::isfinite(options.delay) && options.delay >= 0.0)) throw Error("play: the delay before the first message must be a finite number of seconds >= 0");
   io::BagReader probe = io::BagReader::open(log_path, io::BagReadOptions{options.recover});
+  for (const auto& [from, to] : options.remap) {
+    const auto& all = probe.topics();
+    if (std::none_of(all.begin(), all.end(), [&](const io::TopicInfo& t) { return t.name == from; })) throw Error(log_path + ": has no topic " + from + " to remap");
+    if (to.empty() || to[0] != '/') throw Error("play: remap of " + from + ": the new name '" + to + "' must start with /");
+  }
   for (const std::string& wanted : options.topics) {
     const auto& all = probe.topics();
     if (std::none_of(all.begin(), all.end(), [&](const io::TopicInfo& t) { return t.name == wanted; }))
@@ -45,7 +50,8 @@ PlayReport playLog(const std::string& log_path, const PlayOptions& options) {
   for (const io::TopicInfo& t : probe.topics()) {
     if (!options.topics.empty() && std::find(options.topics.begin(), options.topics.end(), t.name) == options.topics.end()) continue;
     if (t.type.empty() || t.serialization_format != "cdr") continue;  // nothing a DDS reader could take
-    writers.emplace(t.name, node.advertise(t.name, t.type, recordedQos(t)));
+    const auto renamed = options.remap.find(t.name);
+    writers.emplace(t.name, node.advertise(renamed == options.remap.end() ? t.name : renamed->second, t.type, recordedQos(t)));
   }
   rsu_client::DdsNode::Writer clock;
   if (options.publish_clock) {

@@ -158,6 +158,10 @@ struct Pipeline::Impl {
   std::vector<std::string> source_names;  // by SourceId
   std::unique_ptr<ndt::NdtPoseSource> ndt;
   std::mutex ndt_use;  // live: the NDT thread's matching and the pipeline's heading search take turns
+  // The newest scan pushed, for align(): matched on the caller's thread.
+  std::mutex last_scan_mutex;
+  std::shared_ptr<const ndt::PointCloud> last_scan;
+  Stamp last_scan_stamp = 0;
   fusion::SourceId ndt_id = -1;
   Initializer initializer;
   // A start given by hand is held against the map at the next scan and every start_check_interval
@@ -578,7 +582,59 @@ void Pipeline::pushScan(ndt::PointCloud scan, Stamp stamp, Stamp arrival) {
 
 void Pipeline::pushScan(std::shared_ptr<const ndt::PointCloud> scan, Stamp stamp, Stamp arrival) {
   if (!scan) scan = std::make_shared<const ndt::PointCloud>();  // nothing to match: counted as an empty scan
+  {
+    std::lock_guard<std::mutex> lock(impl_->last_scan_mutex);
+    impl_->last_scan = scan;
+    impl_->last_scan_stamp = stamp;
+  }
   impl_->inbox.push(ScanInput{std::move(scan), stamp}, arrival);
+}
+
+AlignOutcome Pipeline::align(const Pose& around) {
+  AlignOutcome out;
+  if (!impl_->ndt) {
+    out.why = "no map: NDT cannot align";
+    return out;
+  }
+  std::shared_ptr<const ndt::PointCloud> scan;
+  Stamp stamp = 0;
+  {
+    std::lock_guard<std::mutex> lock(impl_->last_scan_mutex);
+    scan = impl_->last_scan;
+    stamp = impl_->last_scan_stamp;
+  }
+  if (!scan || scan->empty()) {
+    out.why = "no scan received yet";
+    return out;
+  }
+  // A pose given by a person or a GNSS is off by metres and degrees; NDT converges from within about
+  // a metre and 15 deg: the heading first, then the position around the best heading.
+  std::lock_guard<std::mutex> using_ndt(impl_->ndt_use);
+  const double yaw = rollPitchYaw(around.orientation)[2];
+  ndt::ScanOutcome best;
+  for (const double turn_deg : {0.0, 15.0, -15.0, 30.0, -30.0}) {
+    Pose start = around;
+    start.orientation = quaternionFromRollPitchYaw(0.0, 0.0, yaw + turn_deg * M_PI / 180.0);
+    ndt::ScanOutcome at;
+    impl_->ndt->searchAround(*scan, stamp, start, {}, 8, 0.0, at);
+    ++out.starts;
+    if (at.produced && (!best.produced || at.alignment.nvtl > best.alignment.nvtl)) best = at;
+  }
+  if (best.produced) {
+    ndt::ScanOutcome at;
+    const ndt::ScanOutcome ring = impl_->ndt->searchAround(*scan, stamp, best.pose.pose, {1.5, 3.0}, 8, 0.0, at);
+    out.starts += 17;
+    if (ring.produced && ring.alignment.nvtl > best.alignment.nvtl) best = ring;
+  }
+  if (!best.produced) {
+    out.why = "NDT converged from none of the " + std::to_string(out.starts) + " starting poses";
+    return out;
+  }
+  out.success = true;
+  out.pose = best.pose;
+  out.nvtl = best.alignment.nvtl;
+  out.reliable = best.alignment.nvtl > impl_->config.ndt.source.ndt.nvtl_threshold;
+  return out;
 }
 void Pipeline::pushTwist(fusion::SourceId source, const TwistMeasurement& twist, Stamp arrival) {
   impl_->inbox.push(TwistInput{source, twist}, arrival);

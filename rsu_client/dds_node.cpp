@@ -14,9 +14,12 @@
 
 #include <atomic>
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <thread>
 
 #include "coloc/core/error.hpp"
 #include "dds_participant.hpp"
@@ -36,9 +39,21 @@ std::string ddsTypeName(const std::string& ros_type) {
   return out + "::dds_::" + ros_type.substr(last + 1) + "_";
 }
 
+std::string ddsRequestTypeName(const std::string& ros_srv_type) {
+  const std::string t = ddsTypeName(ros_srv_type);  // pkg::srv::dds_::Name_
+  return t.substr(0, t.size() - 1) + "_Request_";
+}
+std::string ddsResponseTypeName(const std::string& ros_srv_type) {
+  const std::string t = ddsTypeName(ros_srv_type);
+  return t.substr(0, t.size() - 1) + "_Response_";
+}
+std::string ddsRequestTopicName(const std::string& ros_service) { return "rq" + ros_service + "Request"; }
+std::string ddsReplyTopicName(const std::string& ros_service) { return "rr" + ros_service + "Reply"; }
+
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
+using eprosima::fastrtps::rtps::GUID_t;
 
 // A type that is its own serialization: the sample is the CDR bytes, encapsulation header included.
 // DDS matches endpoints by type name, so this writer and reader pair with ROS 2's of the same type.
@@ -82,9 +97,40 @@ Qos applied(Qos q, const TopicQos& t) {
 
 class WriterMatches : public dds::DataWriterListener {
  public:
-  void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override { matched = status.current_count; }
+  void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override {
+    matched = status.current_count;
+    std::lock_guard<std::mutex> lock(mutex);
+    const GUID_t reader = eprosima::fastrtps::rtps::iHandle2GUID(status.last_subscription_handle);
+    if (status.current_count_change > 0) readers.push_back(reader);
+    if (status.current_count_change < 0) readers.erase(std::remove(readers.begin(), readers.end(), reader), readers.end());
+    changed.notify_all();
+  }
+  /// Waits until the reader is matched (a service's reply to a client whose reader is still being discovered).
+  bool waitForReader(const GUID_t& reader, std::chrono::milliseconds timeout) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return changed.wait_for(lock, timeout, [&] { return std::find(readers.begin(), readers.end(), reader) != readers.end(); });
+  }
+  std::atomic<int> matched{0};
+
+ private:
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::vector<GUID_t> readers;
+};
+
+class ReaderMatches : public dds::DataReaderListener {
+ public:
+  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override { matched = status.current_count; }
   std::atomic<int> matched{0};
 };
+
+template <typename Qos>
+Qos serviceQos(Qos q) {
+  TopicQos t;
+  t.reliable = true;  // rmw_qos_profile_services_default: reliable, volatile, keep last 10
+  t.depth = 10;
+  return applied(q, t);
+}
 
 }  // namespace
 
@@ -132,7 +178,11 @@ struct DdsNode::Impl : public dds::DataReaderListener {
   std::vector<std::shared_ptr<Writer::Impl>> writers;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
-  mutable std::mutex mutex;  // setup and counters against the listener
+  // Two locks, never held together: `setup` orders the creation of entities; `mutex` guards the maps
+  // and counters the listeners read. Fast DDS calls listeners while holding its own locks, and takes
+  // those locks when creating entities: creating under `mutex` would deadlock with a listener.
+  std::mutex setup;
+  mutable std::mutex mutex;
 
   dds::Topic* topic(const std::string& ros_topic, const std::string& ros_type) {
     const std::string type_name = ddsTypeName(ros_type);
@@ -151,10 +201,14 @@ struct DdsNode::Impl : public dds::DataReaderListener {
 
   void on_data_available(dds::DataReader* reader) override {
     Callback* callback = nullptr;
+    Service* service = nullptr;
     {
       std::lock_guard<std::mutex> lock(mutex);
       if (Reader* r = find(reader)) callback = &r->callback;
+      const auto found = services.find(reader);
+      if (found != services.end()) service = &found->second;
     }
+    if (service) return takeRequests(reader, *service);
     Bytes bytes;
     dds::SampleInfo info;
     while (reader->take_next_sample(&bytes, &info) == ReturnCode_t::RETCODE_OK) {
@@ -191,6 +245,48 @@ struct DdsNode::Impl : public dds::DataReaderListener {
     std::lock_guard<std::mutex> lock(mutex);
     if (Reader* r = find(reader)) r->status.rejected += status.total_count_change;
   }
+  // One served service: its request reader's handler and its reply writer.
+  struct Service {
+    ServiceHandler handler;
+    dds::DataWriter* reply_writer = nullptr;
+    std::shared_ptr<WriterMatches> reply_matches;
+  };
+  std::map<dds::DataReader*, Service> services;
+  std::vector<std::shared_ptr<Client::Impl>> clients;
+
+  dds::Topic* serviceTopic(const std::string& dds_topic, const std::string& type_name) {
+    auto found = types.find(type_name);
+    if (found == types.end()) found = types.emplace(type_name, dds::TypeSupport(new SerializedType(type_name))).first;
+    dds::Topic* t = ddsTopicFor(participant, dds_topic, found->second);
+    if (t->get_type_name() != type_name) throw Error("DDS: topic " + dds_topic + " is already used with type " + t->get_type_name());
+    return t;
+  }
+
+  // A request taken: the reply goes to the client's reply reader named in the request (rmw_fastrtps's
+  // clients name it), else to its request writer, with the request's sequence number.
+  void takeRequests(dds::DataReader* reader, Service& service) {
+    Bytes bytes;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&bytes, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      eprosima::fastrtps::rtps::SampleIdentity to = info.sample_identity;
+      if (info.related_sample_identity.writer_guid() != GUID_t::unknown()) to.writer_guid(info.related_sample_identity.writer_guid());
+      dds::DataWriter* writer = service.reply_writer;
+      std::shared_ptr<WriterMatches> matches = service.reply_matches;
+      Respond respond = [writer, matches, to](Bytes&& reply) {
+        // A client's reply reader may not be matched yet when its first request arrives: a volatile
+        // reply written before would be lost. rmw_fastrtps waits the same way (its writer's blocking time).
+        const bool to_reader = (to.writer_guid().entityId.value[3] & 0x04) != 0;
+        if (to_reader) matches->waitForReader(to.writer_guid(), std::chrono::seconds(2));
+        eprosima::fastrtps::rtps::WriteParams params;
+        params.related_sample_identity(to);
+        writer->write(&reply, params);
+      };
+      service.handler(std::move(bytes), std::move(respond));
+      bytes = Bytes();
+    }
+  }
+
   OwnedParticipant participant;  // last member: deleted first, while listeners still exist
 };
 
@@ -204,18 +300,21 @@ DdsNode::DdsNode(const DdsConfig& config) : impl_(std::make_unique<Impl>()) {
 DdsNode::~DdsNode() = default;
 
 DdsNode::Writer DdsNode::advertise(const std::string& ros_topic, const std::string& ros_type, const TopicQos& qos) {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::lock_guard<std::mutex> setup(impl_->setup);
   auto w = std::make_shared<Writer::Impl>();
   w->writer = impl_->publisher->create_datawriter(impl_->topic(ros_topic, ros_type), applied(dds::DATAWRITER_QOS_DEFAULT, qos), &w->listener);
   if (!w->writer) throw Error("DDS: cannot publish on " + ddsTopicName(ros_topic) + " (not permitted?)");
-  impl_->writers.push_back(w);
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->writers.push_back(w);
+  }
   Writer writer;
   writer.impl_ = w;
   return writer;
 }
 
 void DdsNode::subscribe(const std::string& ros_topic, const std::string& ros_type, const TopicQos& qos, Callback callback) {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::lock_guard<std::mutex> setup(impl_->setup);
   dds::Topic* topic = impl_->topic(ros_topic, ros_type);
   // Created without a listener, registered, then given one: no sample can reach an unknown reader.
   dds::DataReader* reader = impl_->subscriber->create_datareader(topic, applied(dds::DATAREADER_QOS_DEFAULT, qos), nullptr);
@@ -224,13 +323,18 @@ void DdsNode::subscribe(const std::string& ros_topic, const std::string& ros_typ
   r.status.topic = ros_topic;
   r.status.type = ros_type;
   r.callback = std::move(callback);
-  impl_->readers.emplace(reader, std::move(r));
-  impl_->order.push_back(reader);
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->readers.emplace(reader, std::move(r));
+    impl_->order.push_back(reader);
+  }
   reader->set_listener(impl_.get());
   // A writer may have matched before the listener was set: take the count as it stands.
   dds::SubscriptionMatchedStatus matched;
-  if (reader->get_subscription_matched_status(matched) == ReturnCode_t::RETCODE_OK && matched.current_count > 0)
-    impl_->readers.at(reader).status.matched_writers = matched.current_count;
+  if (reader->get_subscription_matched_status(matched) == ReturnCode_t::RETCODE_OK && matched.current_count > 0) {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->readers.at(reader).status.matched_writers = std::max(impl_->readers.at(reader).status.matched_writers, matched.current_count);
+  }
 }
 
 int DdsNode::matchedWriters() const {
@@ -245,6 +349,83 @@ std::vector<DdsNode::ReaderStatus> DdsNode::readers() const {
   std::vector<ReaderStatus> out;
   for (dds::DataReader* r : impl_->order) out.push_back(impl_->readers.at(r).status);
   return out;
+}
+
+void DdsNode::serve(const std::string& ros_service, const std::string& ros_srv_type, ServiceHandler handler) {
+  std::lock_guard<std::mutex> setup(impl_->setup);
+  dds::Topic* request_topic = impl_->serviceTopic(ddsRequestTopicName(ros_service), ddsRequestTypeName(ros_srv_type));
+  dds::Topic* reply_topic = impl_->serviceTopic(ddsReplyTopicName(ros_service), ddsResponseTypeName(ros_srv_type));
+  Impl::Service service;
+  service.handler = std::move(handler);
+  service.reply_matches = std::make_shared<WriterMatches>();
+  service.reply_writer = impl_->publisher->create_datawriter(reply_topic, serviceQos(dds::DATAWRITER_QOS_DEFAULT), service.reply_matches.get());
+  if (!service.reply_writer) throw Error("DDS: cannot serve " + ros_service + " (no reply writer; not permitted?)");
+  dds::DataReader* reader = impl_->subscriber->create_datareader(request_topic, serviceQos(dds::DATAREADER_QOS_DEFAULT), nullptr);
+  if (!reader) throw Error("DDS: cannot serve " + ros_service + " (no request reader; not permitted?)");
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->services.emplace(reader, std::move(service));
+  }
+  reader->set_listener(impl_.get());
+}
+
+struct DdsNode::Client::Impl {
+  dds::DataWriter* request_writer = nullptr;
+  dds::DataReader* reply_reader = nullptr;
+  WriterMatches writer_matches;
+  ReaderMatches reader_matches;
+  std::mutex mutex;  // one call at a time
+};
+
+bool DdsNode::Client::serverReady() const {
+  return impl_ && impl_->writer_matches.matched.load() > 0 && impl_->reader_matches.matched.load() > 0;
+}
+
+bool DdsNode::Client::waitForServer(double timeout_seconds) const {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
+  while (!serverReady()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+std::optional<std::vector<std::uint8_t>> DdsNode::Client::call(const std::vector<std::uint8_t>& request, double timeout_seconds) {
+  if (!impl_) return std::nullopt;
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  eprosima::fastrtps::rtps::WriteParams params;
+  params.related_sample_identity().writer_guid(impl_->reply_reader->guid());  // where the server replies, as rmw_fastrtps's clients say
+  if (!impl_->request_writer->write(const_cast<Bytes*>(&request), params)) return std::nullopt;
+  const auto sequence = params.sample_identity().sequence_number();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
+  Bytes bytes;
+  dds::SampleInfo info;
+  while (std::chrono::steady_clock::now() < deadline) {
+    while (impl_->reply_reader->take_next_sample(&bytes, &info) == ReturnCode_t::RETCODE_OK) {
+      const auto& related = info.related_sample_identity;
+      const bool ours = related.writer_guid() == impl_->reply_reader->guid() || related.writer_guid() == impl_->request_writer->guid();
+      if (info.valid_data && ours && related.sequence_number() == sequence) return bytes;
+    }
+    impl_->reply_reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 50'000'000));
+  }
+  return std::nullopt;
+}
+
+DdsNode::Client DdsNode::client(const std::string& ros_service, const std::string& ros_srv_type) {
+  std::lock_guard<std::mutex> setup(impl_->setup);
+  dds::Topic* request_topic = impl_->serviceTopic(ddsRequestTopicName(ros_service), ddsRequestTypeName(ros_srv_type));
+  dds::Topic* reply_topic = impl_->serviceTopic(ddsReplyTopicName(ros_service), ddsResponseTypeName(ros_srv_type));
+  auto c = std::make_shared<Client::Impl>();
+  c->request_writer = impl_->publisher->create_datawriter(request_topic, serviceQos(dds::DATAWRITER_QOS_DEFAULT), &c->writer_matches);
+  c->reply_reader = impl_->subscriber->create_datareader(reply_topic, serviceQos(dds::DATAREADER_QOS_DEFAULT), &c->reader_matches);
+  if (!c->request_writer || !c->reply_reader) throw Error("DDS: cannot call " + ros_service + " (not permitted?)");
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->clients.push_back(c);
+  }
+  Client client;
+  client.impl_ = c;
+  return client;
 }
 
 }  // namespace coloc::rsu_client

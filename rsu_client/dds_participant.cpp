@@ -89,8 +89,11 @@ void destroyParticipant(dds::DomainParticipant* participant) {
 }
 
 dds::Topic* topicFor(dds::DomainParticipant* participant, const std::string& ros_topic, dds::TypeSupport& type) {
+  return ddsTopicFor(participant, ddsTopicName(ros_topic), type);
+}
+
+dds::Topic* ddsTopicFor(dds::DomainParticipant* participant, const std::string& name, dds::TypeSupport& type) {
   if (participant->find_type(type.get_type_name()) == nullptr) type.register_type(participant);
-  const std::string name = ddsTopicName(ros_topic);
   if (dds::TopicDescription* existing = participant->lookup_topicdescription(name)) return static_cast<dds::Topic*>(existing);
   dds::Topic* topic = participant->create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
   if (!topic) throw Error("DDS: cannot create topic " + name);

@@ -40,5 +40,8 @@ std::string ddsTopicName(const std::string& ros_topic);
 /// Finds or creates the topic of a registered type.
 eprosima::fastdds::dds::Topic* topicFor(eprosima::fastdds::dds::DomainParticipant* participant, const std::string& ros_topic,
                                         eprosima::fastdds::dds::TypeSupport& type);
+/// The same by DDS topic name (a service's "rq..." and "rr..." topics).
+eprosima::fastdds::dds::Topic* ddsTopicFor(eprosima::fastdds::dds::DomainParticipant* participant, const std::string& dds_topic,
+                                           eprosima::fastdds::dds::TypeSupport& type);
 
 }  // namespace coloc::rsu_client

@@ -15,5 +15,6 @@ void addExperimentCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);
 void addPlayCommand(CLI::App& app);
 void addSmoothCommand(CLI::App& app);
+void addInitializeCommand(CLI::App& app);
 
 }  // namespace coloc::tools

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   coloc::tools::addLocalizeCommand(app);
   coloc::tools::addPlayCommand(app);
   coloc::tools::addSmoothCommand(app);
+  coloc::tools::addInitializeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -3,6 +3,7 @@
 #include <csignal>
 #include <cstdio>
 
+#include "coloc/core/error.hpp"
 #include "coloc/live/log_player.hpp"
 #include "commands.hpp"
 #include "number_checks.hpp"
@@ -35,11 +36,18 @@ void addPlayCommand(CLI::App& app) {
   cmd->add_flag("--no-clock", no_clock, "do not publish the log's time on /clock");
   cmd->add_option("--clock-frequency", options.clock_frequency, "Hz of /clock between messages")->check(finiteNumber(1.0, 10000.0))->capture_default_str();
   cmd->add_option("--delay", options.delay, "seconds to wait before the first message, for discovery")->check(finiteNumber(0.0, 3600.0))->capture_default_str();
+  static std::vector<std::string> remaps;
+  cmd->add_option("--remap", remaps, "publish a topic under another name: FROM:=TO (repeatable), as ros2 bag play --remap");
   addRecoverFlag(cmd, options.recover);
   cmd->add_option("--name", dds.name, "DDS participant name (and security file prefix)");
   addDdsOptions(cmd, dds);
   cmd->callback([] {
     options.publish_clock = !no_clock;
+    for (const std::string& r : remaps) {
+      const auto at = r.find(":=");
+      if (at == std::string::npos || at == 0) throw Error("--remap '" + r + "': expected FROM:=TO");
+      options.remap[r.substr(0, at)] = r.substr(at + 2);
+    }
     options.dds = ddsConfig(dds, "coloc_player");
     printSecurity(options.dds);
     std::signal(SIGINT, requestPlayStop);

@@ -8,14 +8,8 @@
 set -euo pipefail
 coloc=$1
 scenario=$2
-if [ -z "${COLOC_IN_NETNS:-}" ] && ! unshare -n true 2>/dev/null; then
-  echo "SKIP: no network namespace here, and default DDS discovery multicasts: it runs only inside one"
-  exit 77
-fi
-source "$(dirname "$0")/../support/in_network_namespace.sh"
-source "$(dirname "$0")/../support/process_logs.sh"
+source "$(dirname "$0")/../support/in_multicast_namespace.sh"
 unset ROS_DOMAIN_ID
-ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo  # default discovery, inside the namespace
 
 sed 's/lidar: VLP-16/lidar: VLP-32C/' "$scenario" > "$work/site.yaml"
 "$coloc" simulate "$work/site.yaml" --out "$work/sim" > "$work/simulate.txt"

@@ -54,6 +54,7 @@ struct LiveStatus {
   std::uint64_t published = 0;  ///< estimates published
   Stamp clock = 0;              ///< the node's time now
   int matched_writers = 0;      ///< remote writers matched with the node's readers
+  bool activated = true;        ///< outputs flow (live.start_activated, the trigger services)
   /// The fused trajectory as written so far (LiveOptions::trajectory_file).
   std::uint64_t trajectory_points = 0;
   Stamp trajectory_first = 0, trajectory_last = 0;

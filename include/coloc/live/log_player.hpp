@@ -23,6 +23,8 @@ struct PlayOptions {
   double clock_frequency = 100.0;    ///< Hz of /clock between messages (each message also sends its own time first)
   double delay = 0.0;                ///< s to wait after the writers are created (discovery) before the first message
   bool recover = false;              ///< play a log that was never closed up to where it stops (io::BagReadOptions)
+  /// Topics published under another name (recorded name -> published name), as `ros2 bag play --remap`.
+  std::map<std::string, std::string> remap;
   rsu_client::DdsConfig dds;
   std::function<bool()> stop_requested;            ///< polled between messages
   std::function<void(double fraction)> progress;   ///< share of the log played

@@ -148,6 +148,22 @@ struct LiveSection {
   std::string frame_id = "map";
   std::string child_frame_id = "base_link";
   bool reliable = false;  ///< false: ROS 2 sensor-data QoS (best effort) on the inputs
+  // Further outputs, where Autoware's ekf_localizer and ndt_scan_matcher publish them; empty: not published.
+  std::string twist_out_topic = "/localization/pose_twist_fusion_filter/twist_with_covariance";          ///< TwistWithCovarianceStamped
+  std::string biased_pose_topic = "/localization/pose_twist_fusion_filter/biased_pose_with_covariance";  ///< PoseWithCovarianceStamped, yaw without the yaw bias
+  std::string pose_stamped_topic = "/localization/pose_twist_fusion_filter/pose";                        ///< PoseStamped
+  std::string ndt_pose_topic = "/localization/pose_estimator/pose_with_covariance";                      ///< NDT's own poses
+  bool tf = true;           ///< frame_id -> child_frame_id on /tf at every tick
+  bool diagnostics = true;  ///< /diagnostics (diagnostic_msgs/DiagnosticArray)
+  double diagnostics_frequency = 10.0;  ///< Hz, as ekf_localizer publishes them
+  /// Whether outputs flow from the start. Autoware's nodes wait for their trigger_node service
+  /// (pose_initializer's sequence); a node of its own starts at once.
+  bool start_activated = true;
+  // Services (std_srvs/SetBool: true activates, false deactivates and forgets the pose; NDT's alignment
+  // around a pose); empty: not served.
+  std::string ekf_trigger_service;
+  std::string ndt_trigger_service;
+  std::string align_service;
 };
 
 struct Config {

@@ -82,6 +82,16 @@ struct PipelineReport {
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };
 
+/// What an alignment asked of NDT gave (Pipeline::align).
+struct AlignOutcome {
+  bool success = false;   ///< NDT produced a pose
+  bool reliable = false;  ///< its score (NVTL) passed ndt.nvtl_threshold
+  PoseMeasurement pose;   ///< stamped with the scan's stamp
+  double nvtl = 0.0;
+  int starts = 0;         ///< starting poses tried
+  std::string why;        ///< when it did not succeed
+};
+
 /// The name under which the filter counts NDT's poses.
 inline constexpr const char* kNdtSource = "ndt";
 
@@ -136,6 +146,12 @@ class Pipeline {
   /// what has arrived and joins the threads; the destructor stops too.
   void start();
   void stop();
+
+  /// NDT's search around a pose (Autoware's ndt_align_srv, a start or restart from a rough pose):
+  /// the newest scan matched from the pose turned by 0, +-15 and +-30 deg, then from rings of 1.5 and
+  /// 3 m around the best, the best accepted match kept. Called from any thread; it takes turns with
+  /// the NDT thread. Without a map or before any scan it says why.
+  AlignOutcome align(const Pose& around);
 
   /// A snapshot; thread-safe.
   PipelineReport report() const;

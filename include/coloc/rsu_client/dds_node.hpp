@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,12 @@ namespace coloc::rsu_client {
 
 /// "sensor_msgs/msg/PointCloud2" -> "sensor_msgs::msg::dds_::PointCloud2_", as rmw_fastrtps names types.
 std::string ddsTypeName(const std::string& ros_type);
+/// "std_srvs/srv/SetBool" -> "std_srvs::srv::dds_::SetBool_Request_" and "..._Response_".
+std::string ddsRequestTypeName(const std::string& ros_srv_type);
+std::string ddsResponseTypeName(const std::string& ros_srv_type);
+/// "/a/b" -> "rq/a/bRequest" and "rr/a/bReply", as rmw_fastrtps names a service's topics.
+std::string ddsRequestTopicName(const std::string& ros_service);
+std::string ddsReplyTopicName(const std::string& ros_service);
 
 struct TopicQos {
   bool reliable = false;          ///< false: best effort (ROS 2 sensor data)
@@ -74,6 +81,37 @@ class DdsNode {
   };
   /// One entry per subscribe(), in order.
   std::vector<ReaderStatus> readers() const;
+
+  // ROS 2 services as rmw_fastrtps puts them on DDS: requests on "rq" + service + "Request" of type
+  // "pkg::srv::dds_::Name_Request_", replies on "rr" + service + "Reply" of type "..._Response_", both
+  // reliable, volatile, keep last 10. A reply names its request by the related sample identity: the
+  // client's reply reader (or, from a client that sends none, its request writer) and the request's
+  // sequence number. A ROS 2 client on rmw_fastrtps calls coloc's services and coloc calls its.
+
+  /// Hands the reply to its client; callable once, from any thread, at any later time.
+  using Respond = std::function<void(std::vector<std::uint8_t>&& reply)>;
+  /// Called on a DDS thread with each request (CDR bytes); must not throw nor block for long: a
+  /// request that takes time is answered later through `respond`.
+  using ServiceHandler = std::function<void(std::vector<std::uint8_t>&& request, Respond respond)>;
+  /// Serves a ROS service (e.g. "/localization/pose_estimator/trigger_node") of a ROS srv type
+  /// ("std_srvs/srv/SetBool"). Throws coloc::Error if DDS refuses.
+  void serve(const std::string& ros_service, const std::string& ros_srv_type, ServiceHandler handler);
+
+  class Client {
+   public:
+    /// Whether a server's request reader and reply writer are both matched.
+    bool serverReady() const;
+    bool waitForServer(double timeout_seconds) const;
+    /// Sends a request and waits for its reply; nullopt if none came in time.
+    std::optional<std::vector<std::uint8_t>> call(const std::vector<std::uint8_t>& request, double timeout_seconds);
+
+   private:
+    friend class DdsNode;
+    struct Impl;
+    std::shared_ptr<Impl> impl_;
+  };
+  /// A client of a ROS service. Throws coloc::Error if DDS refuses.
+  Client client(const std::string& ros_service, const std::string& ros_srv_type);
 
  private:
   struct Impl;
