@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <mutex>
@@ -12,10 +13,12 @@
 #include "coloc/core/error.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/io/ros_node_interfaces.hpp"
+#include "coloc/pipeline/input_roles.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
 #include "coloc/pipeline/report_json.hpp"
 #include "coloc/rsu_client/dds_node.hpp"
 #include "diagnostics.hpp"
+#include "stamp_clock.hpp"
 
 namespace coloc::live {
 
@@ -64,6 +67,24 @@ struct LiveLocalizer::Impl {
   DiagnosticsMemory diagnostics_memory;
 
   Stamp now() const { return use_sim_time ? sim_now.load() : rsu_client::systemNow(); }
+
+  // The node's time on the header stamps' clock (stamp_clock.hpp): what the pipeline runs on.
+  std::unique_ptr<StampClock> stamps;
+  Stamp pipelineNow() const { return stamps->toStampClock(now()); }
+  /// An input stamped `stamp` that reached the node at `arrival` (node time), on the pipeline's clock.
+  Stamp arrive(Stamp arrival, Stamp stamp) {
+    stamps->observe(arrival, stamp);
+    const Stamp on_stamps = stamps->toStampClock(arrival);
+    // On a clock of their own, no message arrives before it was stamped (as offline); on one clock a
+    // message from the future is the filter's to refuse.
+    return stamps->separate() ? std::max(on_stamps, stamp) : on_stamps;
+  }
+
+  std::set<std::string> subscribed;  // topics with a reader (setup and the housekeeping thread only)
+  std::set<std::string> outputs;     // topics this node publishes: never taken as inputs
+  bool have_map = false;
+  std::optional<rsu_client::RsuRegistry> registry_copy;  // what the pipeline got, for planning discovered topics
+  const rsu_client::RsuRegistry* registry = nullptr;
 
   std::size_t addTopic(const std::string& topic, const std::string& type) {
     std::lock_guard<std::mutex> lock(mutex);
@@ -167,6 +188,94 @@ struct LiveLocalizer::Impl {
     }
   }
 
+  // Subscribes to one input topic as its plan says (the roles of `coloc fuse`): scans to NDT, twists and
+  // poses to their sources, fixes to the checks. Other roles are not taken live.
+  bool subscribeInput(const std::string& topic, const std::string& ros_type, const pipeline::InputPlan& plan) {
+    if (!plan.kind || subscribed.count(topic)) return false;
+    const io::MessageKind kind = *plan.kind;
+    const pipeline::InputConfig* input = nullptr;
+    if (const auto found = config.inputs.find(topic); found != config.inputs.end()) input = &found->second;
+    const Duration extra_delay = input ? fromSeconds(input->additional_delay) : 0;
+    rsu_client::DdsNode::Callback callback;
+    std::size_t t = 0;
+    switch (plan.role) {
+      case pipeline::InputRole::kScan:
+        if (!have_map) return false;
+        t = addTopic(topic, ros_type);
+        callback = [this, t](Bytes&& b, Stamp) {
+          receive(t, b, [this](const Bytes& bytes, Stamp arrival) {
+            const io::PointCloud2 cloud = io::decodePointCloud2(bytes.data(), bytes.size());
+            pipe->pushScan(pipeline::toPointCloud(cloud), cloud.header.stamp, arrive(arrival, cloud.header.stamp));
+          });
+        };
+        break;
+      case pipeline::InputRole::kTwist: {
+        const fusion::SourceId source = pipe->addTwistSource(plan.source.empty() ? topic : plan.source);
+        t = addTopic(topic, ros_type);
+        callback = [this, t, kind, input, source, extra_delay](Bytes&& b, Stamp) {
+          receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
+            bool fallback = false;
+            TwistMeasurement twist = pipeline::twistFromMessage(io::decodeMessage(kind, bytes), input, config.messages, fallback);
+            const Stamp at = arrive(arrival, twist.stamp);
+            twist.stamp -= extra_delay;
+            pipe->pushTwist(source, twist, at);
+          });
+        };
+        break;
+      }
+      case pipeline::InputRole::kPose: {
+        const fusion::SourceId source = pipe->addPoseSource(plan.source.empty() ? topic : plan.source);
+        t = addTopic(topic, ros_type);
+        callback = [this, t, kind, input, source, extra_delay](Bytes&& b, Stamp) {
+          receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
+            bool fallback = false;
+            PoseMeasurement pose = pipeline::poseFromMessage(io::decodeMessage(kind, bytes), input, config.messages, fallback);
+            const Stamp at = arrive(arrival, pose.stamp);
+            pose.stamp -= extra_delay;
+            pipe->pushPose(source, pose, at);
+          });
+        };
+        break;
+      }
+      case pipeline::InputRole::kRsuFix: {
+        t = addTopic(topic, ros_type);
+        callback = [this, t, kind, id = plan.rsu_id](Bytes&& b, Stamp) {
+          receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
+            const rsu_client::RsuFix fix = pipeline::fixFromMessage(io::decodeMessage(kind, bytes), id);
+            pipe->pushFix(fix, arrive(arrival, fix.stamp));
+          });
+        };
+        break;
+      }
+      default:
+        return false;
+    }
+    // Scans: a few in flight (NDT takes the newest); twists come at 50-100 Hz.
+    const int depth = plan.role == pipeline::InputRole::kTwist ? 50 : 5;
+    node->subscribe(topic, ros_type, inputQos(config, depth), std::move(callback));
+    subscribed.insert(topic);
+    return true;
+  }
+
+  // Writers discovered on the domain: a topic the configuration names (inputs:) is subscribed with the
+  // type its writer has; with live.discover_inputs, any topic is planned by its type as `coloc fuse`
+  // plans a log's. The node's own outputs, the initial pose, /clock and ground truth never are.
+  void takeDiscovered() {
+    for (const auto& w : node->takeDiscoveredWriters()) {
+      if (subscribed.count(w.topic) || outputs.count(w.topic) || w.type.empty()) continue;
+      if (w.topic == config.live.initial_pose_topic || w.topic == io::kClockTopic) continue;
+      const bool named = config.inputs.count(w.topic) > 0;
+      if (!named && !config.live.discover_inputs) continue;
+      try {
+        const pipeline::InputPlan plan = pipeline::planInput(w.topic, w.type, config, have_map, registry);
+        if (subscribeInput(w.topic, w.type, plan))
+          event("subscribed to " + w.topic + " (" + w.type + ") as " + pipeline::toString(plan.role) + (named ? " (inputs:)" : " (by its type)"));
+      } catch (const std::exception& e) {
+        event("not subscribed to " + w.topic + ": " + e.what());
+      }
+    }
+  }
+
   // std_srvs/SetBool on a trigger service: true activates, false deactivates. The filter keeps running
   // meanwhile, so that it is ready when activated; the initial pose that follows restarts it.
   void serveTrigger(const std::string& service, std::atomic<bool>& flag) {
@@ -230,6 +339,11 @@ struct LiveLocalizer::Impl {
     while (!quit.load()) {
       std::this_thread::sleep_for(period);
       if (quit.load()) return;
+      try {
+        takeDiscovered();
+      } catch (const std::exception& e) {
+        event(std::string("subscribing to a discovered topic failed: ") + e.what());
+      }
       if (diagnostics_writer.matchedReaders() == 0) continue;
       try {
         const io::DiagnosticArray d =
@@ -249,16 +363,16 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
   if (!options.trajectory_file.empty())
     d.trajectory = std::make_unique<io::TumWriter>(options.trajectory_file, "coloc fused trajectory (live)\nt x y z qx qy qz qw (t: header-stamp clock, s)");
   if (!options.registry && !d.config.rsu.registry.empty()) options.registry = rsu_client::RsuRegistry::load(d.config.rsu.registry);
-  std::vector<std::string> rsu_ids;
-  if (options.registry)
-    for (const auto& r : options.registry->rsus()) rsu_ids.push_back(r.id);
 
   pipeline::PipelineOptions po;
   if (!options.map.empty()) po.map = ndt::TileMap::open(options.map, d.config.ndt.map_tile_size);
-  const bool have_map = po.map.has_value();
+  d.have_map = po.map.has_value();
+  d.registry_copy = options.registry;
+  if (d.registry_copy) d.registry = &*d.registry_copy;
   po.registry = std::move(options.registry);
   po.ndt_thread = true;
-  po.clock = [&d] { return d.now(); };
+  d.stamps = std::make_unique<StampClock>(d.config.replay.clock, d.config.fusion.future_tolerance);
+  po.clock = [&d] { return d.pipelineNow(); };
   d.pipe = std::make_unique<pipeline::Pipeline>(d.config, std::move(po));
   d.pipe->onEstimate([&d](const fusion::Estimate& e) { d.publish(e); });
   d.on_event = options.on_event;
@@ -266,8 +380,6 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
   d.pipe->onPoseInput([&d](const std::string& source, const PoseMeasurement& pose) {
     if (source == pipeline::kNdtSource) d.publishNdtPose(pose);
   });
-  const fusion::SourceId twist_source = d.pipe->addTwistSource(d.config.live.twist_topic);
-
   d.node = std::make_unique<rsu_client::DdsNode>(options.dds);
   rsu_client::TopicQos out_qos;
   out_qos.reliable = true;  // as Autoware's EKF publishes: reliable readers and best-effort ones both match
@@ -280,7 +392,7 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
   d.twist_writer = advertise(d.config.live.twist_out_topic, "geometry_msgs/msg/TwistWithCovarianceStamped", out_qos);
   d.biased_pose_writer = advertise(d.config.live.biased_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
   d.pose_stamped_writer = advertise(d.config.live.pose_stamped_topic, "geometry_msgs/msg/PoseStamped", out_qos);
-  if (have_map) d.ndt_pose_writer = advertise(d.config.live.ndt_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
+  if (d.have_map) d.ndt_pose_writer = advertise(d.config.live.ndt_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", out_qos);
   if (d.config.live.tf) {
     rsu_client::TopicQos tf_qos = out_qos;
     tf_qos.depth = 100;  // tf2_ros's broadcaster: reliable, volatile, keep last 100
@@ -306,6 +418,10 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
     d.align_worker = std::thread([&d] { d.alignLoop(); });
   }
 
+  for (const std::string& topic : {d.config.live.pose_topic, d.config.live.odometry_topic, d.config.live.twist_out_topic, d.config.live.biased_pose_topic,
+                                   d.config.live.pose_stamped_topic, d.config.live.ndt_pose_topic, std::string("/tf"), std::string("/diagnostics")})
+    if (!topic.empty()) d.outputs.insert(topic);
+
   if (d.use_sim_time) {
     const std::size_t t = d.addTopic(io::kClockTopic, io::kClockType);
     rsu_client::TopicQos clock_qos;
@@ -313,33 +429,32 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
     d.node->subscribe(io::kClockTopic, io::kClockType, clock_qos, [&d, t](Bytes&& b, Stamp) {
       d.receive(t, b, [&d](const Bytes& bytes, Stamp) {
         // The node's time is the last /clock received, back in time too (a player that loops or
-        // restarts): the pipeline sees the jump and starts the filter again.
-        d.sim_now.store(io::decodeClock(bytes.data(), bytes.size()));
+        // restarts): the stamps' clock is related afresh, and the pipeline sees the jump and starts the
+        // filter again.
+        const Stamp clock = io::decodeClock(bytes.data(), bytes.size());
+        if (clock + fromSeconds(1.0 / d.config.fusion.predict_frequency) < d.sim_now.load()) d.stamps->reset();
+        d.sim_now.store(clock);
       });
     });
+    d.subscribed.insert(io::kClockTopic);
   }
-  if (have_map) {
-    const std::size_t t = d.addTopic(d.config.live.scan_topic, "sensor_msgs/msg/PointCloud2");
-    d.node->subscribe(d.config.live.scan_topic, "sensor_msgs/msg/PointCloud2", inputQos(d.config, 5), [&d, t](Bytes&& b, Stamp) {
-      d.receive(t, b, [&d](const Bytes& bytes, Stamp arrival) {
-        const io::PointCloud2 cloud = io::decodePointCloud2(bytes.data(), bytes.size());
-        d.pipe->pushScan(pipeline::toPointCloud(cloud), cloud.header.stamp, arrival);
-      });
-    });
+  // The live: section's inputs, then each registered RSU's addressed fixes (the protocol) and its
+  // unaddressed ones, which the checks refuse unless rsu.accept_unaddressed: both are subscribed so
+  // that what arrives on either is counted.
+  if (!d.config.live.scan_topic.empty()) {
+    pipeline::InputPlan scan;
+    scan.role = pipeline::InputRole::kScan;
+    scan.kind = io::MessageKind::kPointCloud2;
+    scan.source = pipeline::kNdtSource;
+    d.subscribeInput(d.config.live.scan_topic, "sensor_msgs/msg/PointCloud2", scan);
   }
-  {
-    const auto kind = io::messageKindOf(d.config.live.twist_type);
-    if (!kind) throw Error("live.twist_type: coloc cannot decode " + d.config.live.twist_type);
-    const std::size_t t = d.addTopic(d.config.live.twist_topic, d.config.live.twist_type);
-    d.node->subscribe(d.config.live.twist_topic, d.config.live.twist_type, inputQos(d.config, 50),
-                      [&d, t, kind = *kind, twist_source](Bytes&& b, Stamp) {
-                        d.receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
-                          bool fallback = false;
-                          const TwistMeasurement twist =
-                              pipeline::twistFromMessage(io::decodeMessage(kind, bytes), nullptr, d.config.messages, fallback);
-                          d.pipe->pushTwist(twist_source, twist, arrival);
-                        });
-                      });
+  if (!d.config.live.twist_topic.empty()) {
+    pipeline::InputPlan twist;
+    twist.role = pipeline::InputRole::kTwist;
+    twist.kind = io::messageKindOf(d.config.live.twist_type);
+    if (!twist.kind) throw Error("live.twist_type: coloc cannot decode " + d.config.live.twist_type);
+    twist.source = d.config.live.twist_topic;
+    d.subscribeInput(d.config.live.twist_topic, d.config.live.twist_type, twist);
   }
   if (!d.config.live.initial_pose_topic.empty()) {
     const std::size_t t = d.addTopic(d.config.live.initial_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped");
@@ -349,23 +464,21 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
                           bool fallback = false;
                           const PoseMeasurement pose = pipeline::poseFromMessage(
                               io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, bytes), nullptr, d.config.messages, fallback);
-                          d.pipe->pushInitialPose(pose, arrival);
+                          d.pipe->pushInitialPose(pose, d.arrive(arrival, pose.stamp));
                         });
                       });
+    d.subscribed.insert(d.config.live.initial_pose_topic);
   }
-  // Each RSU's addressed fixes (the protocol) and its unaddressed ones, which the checks refuse unless
-  // rsu.accept_unaddressed: both are subscribed so that what arrives on either is counted.
-  for (const std::string& id : rsu_ids)
-    for (const auto& [topic, type] : {std::make_pair(rsu_client::addressedFixTopic(id), io::MessageKind::kOdometry),
-                                      std::make_pair(rsu_client::fixTopic(id), io::MessageKind::kPoseWithCovarianceStamped)}) {
-      const std::string ros_type = type == io::MessageKind::kOdometry ? "nav_msgs/msg/Odometry" : "geometry_msgs/msg/PoseWithCovarianceStamped";
-      const std::size_t t = d.addTopic(topic, ros_type);
-      d.node->subscribe(topic, ros_type, inputQos(d.config, 5), [&d, t, id, kind = type](Bytes&& b, Stamp) {
-        d.receive(t, b, [&d, &id, kind](const Bytes& bytes, Stamp arrival) {
-          d.pipe->pushFix(pipeline::fixFromMessage(io::decodeMessage(kind, bytes), id), arrival);
-        });
-      });
-    }
+  if (d.registry)
+    for (const auto& rsu : d.registry->rsus())
+      for (const auto& [topic, kind] : {std::make_pair(rsu_client::addressedFixTopic(rsu.id), io::MessageKind::kOdometry),
+                                        std::make_pair(rsu_client::fixTopic(rsu.id), io::MessageKind::kPoseWithCovarianceStamped)}) {
+        pipeline::InputPlan fix;
+        fix.role = pipeline::InputRole::kRsuFix;
+        fix.kind = kind;
+        fix.rsu_id = rsu.id;
+        d.subscribeInput(topic, std::string(io::rosTypeName(kind)), fix);
+      }
   d.pipe->start();
   d.housekeeping = std::thread([&d, this] { d.housekeepingLoop(*this); });
 }
@@ -406,15 +519,16 @@ LiveStatus LiveLocalizer::status() const {
   if (impl_->node) readers = impl_->node->readers();
   std::lock_guard<std::mutex> lock(impl_->mutex);
   s.topics = impl_->topics;
-  // One reader per topic, subscribed in the order the topics were added.
-  for (std::size_t i = 0; i < s.topics.size() && i < readers.size(); ++i) {
-    TopicStatus& t = s.topics[i];
-    t.matched_writers = readers[i].matched_writers;
-    t.sequence_gaps = readers[i].sequence_gaps;
-    t.lost = readers[i].lost;
-    t.rejected = readers[i].rejected;
-    s.matched_writers += readers[i].matched_writers;
-  }
+  // One reader per topic.
+  for (const auto& r : readers)
+    for (TopicStatus& t : s.topics)
+      if (t.topic == r.topic) {
+        t.matched_writers = r.matched_writers;
+        t.sequence_gaps = r.sequence_gaps;
+        t.lost = r.lost;
+        t.rejected = r.rejected;
+        s.matched_writers += r.matched_writers;
+      }
   s.trajectory_points = impl_->trajectory ? impl_->trajectory->points() : 0;
   s.trajectory_first = impl_->trajectory_first;
   s.trajectory_last = impl_->trajectory_last;

@@ -1,6 +1,7 @@
 #include "coloc/rsu_client/dds_node.hpp"
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -19,6 +20,7 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "coloc/core/error.hpp"
@@ -37,6 +39,23 @@ std::string ddsTypeName(const std::string& ros_type) {
   std::string out;
   for (char c : prefix) out += c == '/' ? std::string("::") : std::string(1, c);
   return out + "::dds_::" + ros_type.substr(last + 1) + "_";
+}
+
+std::string rosTypeName(const std::string& dds_type) {
+  const std::string marker = "::dds_::";
+  const auto at = dds_type.find(marker);
+  if (at == std::string::npos || dds_type.size() < at + marker.size() + 2 || dds_type.back() != '_') return "";
+  std::string out;
+  const std::string prefix = dds_type.substr(0, at);
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    if (prefix.compare(i, 2, "::") == 0) {
+      out += '/';
+      ++i;
+    } else {
+      out += prefix[i];
+    }
+  }
+  return out + "/" + dds_type.substr(at + marker.size(), dds_type.size() - at - marker.size() - 1);
 }
 
 std::string ddsRequestTypeName(const std::string& ros_srv_type) {
@@ -287,11 +306,35 @@ struct DdsNode::Impl : public dds::DataReaderListener {
     }
   }
 
+  // Discovery of remote writers, reported on a DDS thread and kept until taken.
+  struct Discovery : public dds::DomainParticipantListener {
+    void on_publisher_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+      if (info.status != eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
+      const std::string topic = info.info.topicName().to_string(), type = info.info.typeName().to_string();
+      if (topic.rfind("rt/", 0) != 0) return;  // services and non-ROS topics
+      std::lock_guard<std::mutex> lock(mutex);
+      if (seen.insert(topic + "\n" + type).second) fresh.push_back({topic.substr(2), rosTypeName(type)});
+    }
+    std::mutex mutex;
+    std::set<std::string> seen;
+    std::vector<DiscoveredWriter> fresh;
+  };
+  Discovery discovery;
+
   OwnedParticipant participant;  // last member: deleted first, while listeners still exist
 };
 
+std::vector<DdsNode::DiscoveredWriter> DdsNode::takeDiscoveredWriters() {
+  std::lock_guard<std::mutex> lock(impl_->discovery.mutex);
+  std::vector<DiscoveredWriter> out;
+  out.swap(impl_->discovery.fresh);
+  return out;
+}
+
 DdsNode::DdsNode(const DdsConfig& config) : impl_(std::make_unique<Impl>()) {
   impl_->participant = createParticipant(config);
+  // Discovery only: every status stays with the entities' own listeners.
+  impl_->participant->set_listener(&impl_->discovery, dds::StatusMask::none());
   impl_->publisher = impl_->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   impl_->subscriber = impl_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (!impl_->publisher || !impl_->subscriber) throw Error("DDS: cannot create a publisher and a subscriber");

@@ -86,7 +86,9 @@ void addLocalizeCommand(CLI::App& app) {
   static bool sim_time = false;
   static double duration = 0.0, idle = 0.0;
   static DdsOptions dds;
-  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles) for NDT")->required();
+  cmd->add_option("--map", map, "point-cloud map (PCD file or folder of PCD tiles) for NDT; without it, no scan is subscribed to");
+  static bool discover = false;
+  cmd->add_flag("--discover-inputs", discover, "take every topic on the domain by its type, as `coloc fuse` takes a log's (live.discover_inputs)");
   cmd->add_option("--config", config_path, "YAML configuration (see `coloc config`; topics in its live: section)")->check(CLI::ExistingFile);
   cmd->add_option("--rsu-registry", registry, "RSU registry (YAML): whose fixes to subscribe to and accept (default: rsu.registry of the config)")
       ->check(CLI::ExistingFile);
@@ -101,6 +103,7 @@ void addLocalizeCommand(CLI::App& app) {
     if (!config_path.empty()) options.config = pipeline::loadConfig(config_path);
     if (!registry.empty()) options.registry = rsu_client::RsuRegistry::load(registry);
     if (dds.reliable) options.config.live.reliable = true;
+    if (discover) options.config.live.discover_inputs = true;
     options.map = map;
     options.use_sim_time = sim_time;
     options.dds = ddsConfig(dds, "coloc_localizer");

@@ -148,6 +148,11 @@ struct LiveSection {
   std::string frame_id = "map";
   std::string child_frame_id = "base_link";
   bool reliable = false;  ///< false: ROS 2 sensor-data QoS (best effort) on the inputs
+  /// Every topic a writer on the domain publishes is planned by its type, as `coloc fuse` plans a log's
+  /// (pose sources, twist sources, scans, fixes), besides the topics above and those `inputs:` names.
+  /// Off by default: in a running system the topics of other localizers (and this node's republished
+  /// outputs, as Autoware's stop filter's) would become inputs.
+  bool discover_inputs = false;
   // Further outputs, where Autoware's ekf_localizer and ndt_scan_matcher publish them; empty: not published.
   std::string twist_out_topic = "/localization/pose_twist_fusion_filter/twist_with_covariance";          ///< TwistWithCovarianceStamped
   std::string biased_pose_topic = "/localization/pose_twist_fusion_filter/biased_pose_with_covariance";  ///< PoseWithCovarianceStamped, yaw without the yaw bias

@@ -17,6 +17,8 @@ namespace coloc::rsu_client {
 
 /// "sensor_msgs/msg/PointCloud2" -> "sensor_msgs::msg::dds_::PointCloud2_", as rmw_fastrtps names types.
 std::string ddsTypeName(const std::string& ros_type);
+/// "sensor_msgs::msg::dds_::PointCloud2_" -> "sensor_msgs/msg/PointCloud2"; empty for a name not in that form.
+std::string rosTypeName(const std::string& dds_type);
 /// "std_srvs/srv/SetBool" -> "std_srvs::srv::dds_::SetBool_Request_" and "..._Response_".
 std::string ddsRequestTypeName(const std::string& ros_srv_type);
 std::string ddsResponseTypeName(const std::string& ros_srv_type);
@@ -112,6 +114,14 @@ class DdsNode {
   };
   /// A client of a ROS service. Throws coloc::Error if DDS refuses.
   Client client(const std::string& ros_service, const std::string& ros_srv_type);
+
+  /// A remote writer of a ROS topic ("rt/..."), as discovery reports it: its ROS name and type.
+  struct DiscoveredWriter {
+    std::string topic, type;
+  };
+  /// The remote writers discovered since the last call, each topic and type once: what the domain
+  /// publishes, for a node that subscribes by type as `coloc fuse` plans a log's topics.
+  std::vector<DiscoveredWriter> takeDiscoveredWriters();
 
  private:
   struct Impl;

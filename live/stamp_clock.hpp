@@ -1,0 +1,39 @@
+#pragma once
+// The node's time on the clock of the messages' header stamps. A node runs on the system clock or on
+// /clock; a recording made with simulation time stamps its messages on the simulator's clock while a
+// player's /clock is the recorder's wall clock (the nav2 recording: stamps near 924 s, /clock near
+// 1.78e9 s). As `coloc fuse` does offline (replay.clock), such stamps are recognised and the node's time
+// is moved onto their clock by the smallest delay seen: every message arrives after it was stamped, and
+// the least-delayed one arrived the moment it was stamped.
+#include <mutex>
+
+#include "coloc/core/time.hpp"
+#include "coloc/pipeline/config.hpp"
+
+namespace coloc::live {
+
+class StampClock {
+ public:
+  /// `same_within`: offsets (arrival - stamp) from minus `tolerance` to this many seconds mean one clock (auto).
+  StampClock(pipeline::ClockMode mode, double tolerance, double same_within = 10.0);
+
+  /// A stamped input arrived at `arrival` (node time).
+  void observe(Stamp arrival, Stamp stamp);
+  /// Node time on the stamps' clock. In auto mode, 0 until the first stamped input decides: the filter
+  /// then sees its clock start rather than jump back.
+  Stamp toStampClock(Stamp node_time) const;
+  /// The node's clock went back (a log played again): the clocks are related afresh.
+  void reset();
+  bool separate() const;
+  /// Node time minus stamp time, when separate.
+  Duration offset() const;
+
+ private:
+  pipeline::ClockMode mode_;
+  Duration tolerance_, same_within_;
+  mutable std::mutex mutex_;
+  bool decided_ = false, separate_ = false, have_offset_ = false;
+  Duration offset_ = 0;
+};
+
+}  // namespace coloc::live
