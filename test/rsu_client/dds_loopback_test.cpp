@@ -186,9 +186,37 @@ TEST(DdsLoopback, EverySampleLostBetweenTwoTakenIsCountedAsASequenceGap) {
   EXPECT_LT(indices.size(), static_cast<std::size_t>(kSamples)) << "nothing was lost: the test no longer forces a loss";
 }
 
+// A service as rmw_fastrtps puts it on DDS: the client's request, the server's reply tied to it by the
+// related sample identity; two requests get their own replies, in the order asked.
+TEST(DdsLoopback, AServiceAnswersEachRequestOfItsClient) {
+  DdsNode server(testConfig(75)), caller(testConfig(75));
+  server.serve("/test/echo", "std_srvs/srv/SetBool", [](std::vector<std::uint8_t>&& request, DdsNode::Respond respond) {
+    std::vector<std::uint8_t> reply = request;
+    reply.push_back(0x2a);
+    respond(std::move(reply));
+  });
+  DdsNode::Client client = caller.client("/test/echo", "std_srvs/srv/SetBool");
+  ASSERT_TRUE(client.waitForServer(10.0));
+  const auto first = client.call({0, 1, 0, 0, 1}, 10.0);
+  const auto second = client.call({0, 1, 0, 0, 0}, 10.0);
+  ASSERT_TRUE(first && second);
+  EXPECT_EQ(*first, (std::vector<std::uint8_t>{0, 1, 0, 0, 1, 0x2a}));
+  EXPECT_EQ(*second, (std::vector<std::uint8_t>{0, 1, 0, 0, 0, 0x2a}));
+  // A service nobody serves: no reply, within the time given.
+  DdsNode::Client nobody = caller.client("/test/nobody", "std_srvs/srv/SetBool");
+  EXPECT_FALSE(nobody.waitForServer(0.3));
+  EXPECT_FALSE(nobody.call({0, 1, 0, 0, 1}, 0.3).has_value());
+}
+
 TEST(DdsTopics, FollowTheRos2NamingRules) {
   EXPECT_EQ(fixTopic("rsu_a"), "/rsu/rsu_a/fix");
   EXPECT_STREQ(kVehicleDimensionsTopic, "/vehicle/dimensions");
+  EXPECT_EQ(rosTypeName("sensor_msgs::msg::dds_::PointCloud2_"), "sensor_msgs/msg/PointCloud2");
+  EXPECT_EQ(rosTypeName("KeyedSeq"), "");
+  EXPECT_EQ(ddsRequestTypeName("std_srvs/srv/SetBool"), "std_srvs::srv::dds_::SetBool_Request_");
+  EXPECT_EQ(ddsResponseTypeName("std_srvs/srv/SetBool"), "std_srvs::srv::dds_::SetBool_Response_");
+  EXPECT_EQ(ddsRequestTopicName("/localization/pose_estimator/trigger_node"), "rq/localization/pose_estimator/trigger_nodeRequest");
+  EXPECT_EQ(ddsReplyTopicName("/localization/pose_estimator/trigger_node"), "rr/localization/pose_estimator/trigger_nodeReply");
 }
 
 }  // namespace
