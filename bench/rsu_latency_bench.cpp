@@ -33,6 +33,7 @@ int main() {
   constexpr int kFixes = 1000;
   pipeline::Config config;
   config.fusion.auto_initialize = false;
+  config.rsu.checks.station_id = 7;  // the vehicle's CAM station id: fixes are addressed to it (README, the RSU fix protocol)
   pipeline::PipelineOptions options;
   options.registry = rsu_client::RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [0, 0], lidar_model: VLP-32C}\n", "bench");
   pipeline::Pipeline vehicle(config, std::move(options));
@@ -84,7 +85,7 @@ int main() {
       std::lock_guard<std::mutex> lock(mutex);
       sent[stamp] = Clock::now();
     }
-    publisher.publish({stamp, "rsu_a", 10.0, 0.5, std::nullopt, std::nullopt}, 0.00681);  // a vehicle standing in view
+    publisher.publish({stamp, "rsu_a", 10.0, 0.5, std::nullopt, std::nullopt, 7u}, 0.00681);  // a vehicle standing in view
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
