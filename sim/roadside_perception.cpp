@@ -88,6 +88,7 @@ const char* toString(Refusal r) {
     case Refusal::kInconsistent: return "disagrees with the vehicle's track";
     case Refusal::kCornerNotSeen: return "one face seen, no corner to place the vehicle on";
     case Refusal::kBeyondOracleLimit: return "beyond the oracle limit from the true position (analysis bound)";
+    case Refusal::kHeadingDisagrees: return "fitted heading away from the CAM's";
   }
   return "?";
 }
@@ -148,6 +149,12 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
                                       std::clamp(lidar_local.y(), -0.5 * width, 0.5 * width));
   const double footprint_range = (lidar_local - nearest_local).norm();
   constexpr double kOccluderClearance = 0.3;  // m nearer than the footprint: the footprint's own error and noise
+  // The line of sight from the LiDAR to the top of the body part the fit uses, at the footprint's
+  // nearest range: a point below it at its own range hides nothing of that part (from a high mount,
+  // a pedestrian or an uneven road between; from a 2 m mast, a car still does).
+  const double lidar_height = impl_->mount.position.z();
+  const double sight_top = c.height_cut ? c.cut_height : c.occlusion_top;
+  const auto sightHeight = [&](double range) { return lidar_height + (sight_top - lidar_height) * range / std::max(footprint_range, 1e-3); };
   // A point whose bearing is further off the expected one than the sector reaches on either side is
   // outside it: a cosine against a bound rules out most near points without the two arc tangents and
   // the wrap. The margin, a microradian, is far above either way's rounding (1e-15), so every point
@@ -155,11 +162,12 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   const double reach = std::max(-bearing_lo, bearing_hi) + 1e-6;
   const double cos_reach = reach < M_PI ? std::cos(reach) : -2.0;
   const Eigen::Vector2d toward(std::cos(bearing0), std::sin(bearing0));
-  const auto inSector = [&](const Eigen::Vector2d& xy) {
+  const auto inSector = [&](const Eigen::Vector2d& xy, double height) {
     // Range first: most of a frame lies beyond the vehicle, and needs no bearing.
     const Eigen::Vector2d d = xy - lidar;
     const double range = d.norm();
     if (!(range < footprint_range - kOccluderClearance)) return false;
+    if (height < sightHeight(range)) return false;
     if (d.dot(toward) < cos_reach * range) return false;
     const double b = wrapAngle(std::atan2(xy.y() - lidar.y(), xy.x() - lidar.x()) - bearing0);
     return b >= bearing_lo && b <= bearing_hi;
@@ -177,7 +185,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     const double height = p.z() + impl_->mount.position.z();
     if (height < 0.05) continue;  // the road itself
     const bool near = (xy - reference).norm() <= c.search_radius;
-    if (!near && !(c.attribute && inSector(xy))) continue;
+    if (!near && !(c.attribute && inSector(xy, height))) continue;
     if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq)
       continue;
     if (near) foreground.emplace_back(xy.x(), xy.y(), height);
@@ -252,7 +260,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
       int n = far_occluders;
       for (const Object& o : objects)
         if (&o != except)
-          for (std::size_t i : o.points) n += inSector(foreground[i].head<2>()) ? 1 : 0;
+          for (std::size_t i : o.points) n += inSector(foreground[i].head<2>(), foreground[i].z()) ? 1 : 0;
       return n;
     };
     if (candidates.empty()) return finish(occluding(nullptr) >= c.occlusion_points ? Refusal::kOccluded : Refusal::kNoVehicle);
@@ -281,6 +289,12 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.corner_seen = box.corner_seen;
   out.face_shortfall = box.face_shortfall;
   if (c.attribute && c.align_true_size && box.face_shortfall > c.max_face_shortfall) return finish(Refusal::kCornerNotSeen);
+  // The fit's heading against the CAM's (modulo a half turn: the L-shape cannot tell front from back).
+  if (c.attribute && c.max_heading_disagreement > 0.0) {
+    const double off = std::abs(wrapAngle(2.0 * (box.yaw - heading_prior))) / 2.0;
+    out.heading_disagreement = off;
+    if (off > c.max_heading_disagreement) return finish(Refusal::kHeadingDisagrees);
+  }
   const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
   if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);
   out.found = true;

@@ -8,6 +8,7 @@
 // vehicle beyond doubt (nothing at the CAM's position, a cluster larger than the vehicle, two objects
 // there, something between the RSU and the vehicle). A refused fix beats a wrong one.
 #include <Eigen/Core>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -33,9 +34,16 @@ struct RoadsidePerceptionConfig {
   double size_margin = 0.6;         ///< m
   double attribution_radius = 1.2;  ///< m
   int min_object_points = 5;
-  /// Points of other objects that hide part of the vehicle's expected footprint from the LiDAR (nearer
-  /// to it, within the footprint's bearing) make the view partial: refused from this many.
+  /// Points of other objects that hide part of the vehicle's expected footprint from the LiDAR make the
+  /// view partial: refused from this many. A point hides it when it is nearer, within the footprint's
+  /// bearing, and rises above the line of sight from the LiDAR to the top of the part the fit uses
+  /// (cut_height; occlusion_top without the cut) at the footprint's nearest range: from a high pole a
+  /// pedestrian or a kerb halfway sees under that line, from a 2 m mast a car does not.
   int occlusion_points = 5;
+  double occlusion_top = 1.2;  ///< m, the top of a car's lower body, when height_cut is off
+  /// The fitted heading against the CAM's: a fit turned further than this put its box on the wrong faces
+  /// (real frames: fixes 69-73 cm off with headings 22-26 deg wrong). Refused beyond it; <= 0: no check.
+  double max_heading_disagreement = 10.0 * M_PI / 180.0;  ///< rad
   /// The true-size box rests on the fitted corner nearest the LiDAR. With one face of the vehicle seen
   /// and no corner, that face's end is a corner only if the face is seen whole; one shorter than its side
   /// of the vehicle by more than this (head-on from afar, a high mount's few beams on the chassis) puts
@@ -63,9 +71,10 @@ enum class Refusal {
   /// Not the perception's: the twin's analysis bound (TwinRecordingOptions::oracle_fix_limit) withheld
   /// a fix farther than its limit from the vehicle's true position, which no RSU can know.
   kBeyondOracleLimit,
+  kHeadingDisagrees,  ///< the fitted heading is further from the CAM's than max_heading_disagreement
 };
 const char* toString(Refusal r);
-inline constexpr int kRefusalCount = 9;
+inline constexpr int kRefusalCount = 10;
 
 struct VehicleDetection {
   bool found = false;
@@ -76,6 +85,7 @@ struct VehicleDetection {
   Eigen::Vector2d alignment_point = Eigen::Vector2d::Zero();
   bool corner_seen = true;         ///< AlignedBox::corner_seen of the fit
   double face_shortfall = 0.0;     ///< AlignedBox::face_shortfall of the fit, m
+  double heading_disagreement = 0.0;  ///< rad, the fitted heading against the CAM's, modulo a half turn
   std::size_t foreground_points = 0, fit_points = 0;
   double processing_ms = 0.0;      ///< measured, the whole pipeline
 };
