@@ -344,13 +344,13 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   if (!results.rsu_frames.empty()) {
     std::ostringstream csv;
     csv << "site_lidar,frames,frames_with_neighbours,fixes_sent,gross_fixes,gross_fixes_with_neighbours,gross_per_100_frames_with_neighbours";
-    for (int r = 1; r < sim::kRefusalCount; ++r) csv << ",refused_" << r;
+    for (int r = 1; r < roadside::kRefusalCount; ++r) csv << ",refused_" << r;
     csv << "\n";
     attribution_md << "| site, roadside LiDAR | frames in coverage | with neighbours | fixes sent | refused (reasons) | gross fixes sent "
                       "(> 0.3 m) | per 100 frames with neighbours |\n|---|---|---|---|---|---|---|\n";
     for (const auto& [key, frames] : results.rsu_frames) {
       std::size_t with = 0, sent = 0, gross = 0, gross_with = 0;
-      std::array<std::size_t, sim::kRefusalCount> refused{};
+      std::array<std::size_t, roadside::kRefusalCount> refused{};
       for (const RsuFrameRecord& f : frames) {
         with += f.neighbours ? 1 : 0;
         if (!f.found) {
@@ -361,13 +361,13 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         if (f.error > 0.3) ++gross, gross_with += f.neighbours ? 1 : 0;
       }
       std::string reasons;
-      for (int r = 1; r < sim::kRefusalCount; ++r)
-        if (refused[r]) reasons += (reasons.empty() ? "" : "; ") + std::to_string(refused[r]) + " " + sim::toString(static_cast<sim::Refusal>(r));
+      for (int r = 1; r < roadside::kRefusalCount; ++r)
+        if (refused[r]) reasons += (reasons.empty() ? "" : "; ") + std::to_string(refused[r]) + " " + roadside::toString(static_cast<roadside::Refusal>(r));
       const double per100 = with ? 100.0 * static_cast<double>(gross_with) / static_cast<double>(with) : 0.0;
       attribution_md << "| " << key << " | " << frames.size() << " | " << with << " | " << sent << " | " << (reasons.empty() ? "none" : reasons) << " | "
                      << gross << " | " << (with ? fmt("%.1f", per100) : std::string("-")) << " |\n";
       csv << key << "," << frames.size() << "," << with << "," << sent << "," << gross << "," << gross_with << "," << per100;
-      for (int r = 1; r < sim::kRefusalCount; ++r) csv << "," << refused[r];
+      for (int r = 1; r < roadside::kRefusalCount; ++r) csv << "," << refused[r];
       csv << "\n";
     }
     writeFile(out_dir + "/attribution.csv", csv.str());

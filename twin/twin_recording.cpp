@@ -19,9 +19,9 @@
 #include "coloc/ndt/tile_map.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
-#include "coloc/sim/fix_consistency.hpp"
+#include "coloc/roadside/fix_consistency.hpp"
 #include "coloc/sim/lidar_model.hpp"
-#include "coloc/sim/roadside_perception.hpp"
+#include "coloc/roadside/roadside_perception.hpp"
 #include "coloc/sim/survey_map.hpp"
 #include "coloc/sim/vehicle_body.hpp"
 #include "coloc/replay/replay_cache.hpp"
@@ -346,15 +346,15 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   struct Rsu {
     sim::ScenarioRsu info;
     sim::LidarSpec lidar;
-    std::vector<sim::RoadsidePerception> perception;  ///< kVariants, or only the first
+    std::vector<roadside::RoadsidePerception> perception;  ///< kVariants, or only the first
     rsu_client::LinkEmulator link;
     double variance;
     double range;
     sim::LidarSpec ideal_lidar;
-    std::unique_ptr<sim::RoadsidePerception> ideal_perception;
-    sim::FixConsistency consistency{}, ideal_consistency{};
+    std::unique_ptr<roadside::RoadsidePerception> ideal_perception;
+    roadside::FixConsistency consistency{}, ideal_consistency{};
     /// Per other connected vehicle: its track and its share of the radio link.
-    std::vector<sim::FixConsistency> connected_consistency;
+    std::vector<roadside::FixConsistency> connected_consistency;
     std::vector<rsu_client::LinkEmulator> connected_links;
   };
   std::vector<std::size_t> connected;  // the traffic that is connected
@@ -362,7 +362,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     if (scenario.traffic[i].station_id) connected.push_back(i);
   std::vector<Rsu> rsus;
   for (const sim::ScenarioRsu& r : scenario.rsus) {
-    sim::RsuMount mount;
+    roadside::RsuMount mount;
     mount.position = {r.position.x(), r.position.y(), r.height};
     mount.yaw = r.yaw;
     const Eigen::Isometry3d pose = Eigen::Translation3d(mount.position) * Eigen::AngleAxisd(r.yaw, Eigen::Vector3d::UnitZ());
@@ -371,9 +371,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
     rsu_client::LinkConfig l = options.link;
     l.seed = scenario.seed + rsus.size() + 1;
-    std::vector<sim::RoadsidePerception> perception;
+    std::vector<roadside::RoadsidePerception> perception;
     for (std::size_t v = 0; v < (options.perception_ablation ? kVariants.size() : 1); ++v) {
-      sim::RoadsidePerceptionConfig c;
+      roadside::RoadsidePerceptionConfig c;
       c.align_true_size = kVariants[v].align_true_size;
       c.height_cut = kVariants[v].height_cut;
       perception.emplace_back(reference, mount, c);
@@ -387,7 +387,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     }
     if (ideal_world) {
       rsu.ideal_lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), sim::ErrorSources::ideal());
-      rsu.ideal_perception = std::make_unique<sim::RoadsidePerception>(frameOf(rsu.ideal_lidar, surveyed, pose, ideal_rng), mount);
+      rsu.ideal_perception = std::make_unique<roadside::RoadsidePerception>(frameOf(rsu.ideal_lidar, surveyed, pose, ideal_rng), mount);
     }
     rsus.push_back(std::move(rsu));
   }
@@ -523,7 +523,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         if (!at_capture || (at_capture->head<2>() - r.info.position).norm() > r.range) continue;
         std::normal_distribution<double> cam_error(0.0, 0.3);
         const Eigen::Vector2d cam_position = at_capture->head<2>() + Eigen::Vector2d(cam_error(connected_rng), cam_error(connected_rng));
-        sim::VehicleDetection od = r.perception[0].detect(frame, at(capture), cam_position, at_capture->z(), other.body.length, other.body.width);
+        roadside::VehicleDetection od = r.perception[0].detect(frame, at(capture), cam_position, at_capture->z(), other.body.length, other.body.width);
         const Eigen::Vector2d other_velocity = other.speed * Eigen::Vector2d(std::cos(at_capture->z()), std::sin(at_capture->z()));
         if (!od.found) {
           r.connected_consistency[j].miss();
@@ -541,9 +541,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
       std::normal_distribution<double> cam(0.0, 0.3);
       const Eigen::Vector2d reference = seen.position + Eigen::Vector2d(cam(rng), cam(rng));
-      sim::VehicleDetection d;
+      roadside::VehicleDetection d;
       for (std::size_t v = 0; v < r.perception.size(); ++v) {
-        const sim::VehicleDetection dv = r.perception[v].detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
+        const roadside::VehicleDetection dv = r.perception[v].detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
         if (v == 0) {
           d = dv;
           summary.perception_seconds += d.processing_ms * 1e-3;
@@ -559,9 +559,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       }
       // The CAM's velocity carries the previous frame's fix to this one.
       const Eigen::Vector2d velocity = seen.speed * Eigen::Vector2d(std::cos(seen.yaw), std::sin(seen.yaw));
-      const auto confirm = [&](sim::VehicleDetection& det, sim::FixConsistency& consistency) {
+      const auto confirm = [&](roadside::VehicleDetection& det, roadside::FixConsistency& consistency) {
         if (!det.found) return consistency.miss();
-        if (!consistency.agrees(det.stamp, det.position, velocity)) det.found = false, det.refusal = sim::Refusal::kInconsistent;
+        if (!consistency.agrees(det.stamp, det.position, velocity)) det.found = false, det.refusal = roadside::Refusal::kInconsistent;
       };
       confirm(d, r.consistency);
       RsuFrameRecord record;
@@ -575,7 +575,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         frameOf(r.ideal_lidar, ideal_world->caster(), pose, ideal_rng, frame_room, ideal_frame);
         summary.ray_casting_seconds += since(c2);
         summary.rays += raysPerSweep(r.ideal_lidar);
-        sim::VehicleDetection di = r.ideal_perception->detect(ideal_frame, at(capture), reference, seen.yaw, ideal_world->egoBody().length,
+        roadside::VehicleDetection di = r.ideal_perception->detect(ideal_frame, at(capture), reference, seen.yaw, ideal_world->egoBody().length,
                                                                     ideal_world->egoBody().width);
         confirm(di, r.ideal_consistency);
         if (di.found) record.ideal_error = (di.position - seen.position).norm();
@@ -583,7 +583,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const auto keep = [&](const RsuFrameRecord& f) {
         summary.rsu_frames[r.info.id].push_back(f);
         frames_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << f.distance << "," << (f.neighbours ? 1 : 0)
-                   << "," << (f.found ? "fix" : sim::toString(f.refusal)) << "," << (f.found ? f.error : std::nan("")) << ","
+                   << "," << (f.found ? "fix" : roadside::toString(f.refusal)) << "," << (f.found ? f.error : std::nan("")) << ","
                    << (f.ideal_error >= 0.0 ? f.ideal_error : std::nan("")) << "," << f.fit_points << "\n";
       };
       if (!d.found) {
@@ -604,7 +604,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const sim::VehicleState at_stamp = drive.at(capture + stamp_offset);
       if (withheld) {  // after the draws a sent fix makes: every other fix of the drive is as without the oracle
         record.found = false;
-        record.refusal = sim::Refusal::kBeyondOracleLimit;
+        record.refusal = roadside::Refusal::kBeyondOracleLimit;
         keep(record);
         continue;
       }

@@ -149,7 +149,7 @@ TEST(TwinRecording, TheOracleLimitWithholdsExactlyTheFixesFartherThanItFromTheTr
   EXPECT_GT(beyond, 5u);
   for (const Eigen::Vector2d& e : bounded.fix_errors.at(id)) EXPECT_LE(e.norm(), limit);
   std::size_t refused = 0;
-  for (const RsuFrameRecord& f : bounded.rsu_frames.at(id)) refused += f.refusal == sim::Refusal::kBeyondOracleLimit ? 1 : 0;
+  for (const RsuFrameRecord& f : bounded.rsu_frames.at(id)) refused += f.refusal == roadside::Refusal::kBeyondOracleLimit ? 1 : 0;
   EXPECT_EQ(refused, beyond);
   EXPECT_EQ(bounded.rsu_frames.at(id).size(), all.rsu_frames.at(id).size());  // every frame accounted for
 

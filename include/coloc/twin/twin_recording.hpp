@@ -17,7 +17,7 @@
 #include "coloc/rsu_client/link_emulator.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/sweep_cache.hpp"
-#include "coloc/sim/roadside_perception.hpp"
+#include "coloc/roadside/roadside_perception.hpp"
 #include "coloc/sim/scene.hpp"
 
 namespace coloc::replay {
@@ -58,7 +58,7 @@ struct TwinRecordingOptions {
   bool perfect_rsus = false;
   /// An analysis bound, not a perception: each RSU withholds every fix whose position (before its
   /// survey error) is farther than this from the vehicle's true position, which no RSU can know; such
-  /// frames count as refused (sim::Refusal::kBeyondOracleLimit). What a perception that never sent a
+  /// frames count as refused (roadside::Refusal::kBeyondOracleLimit). What a perception that never sent a
   /// fix of the tails would give. m; 0: off.
   double oracle_fix_limit = 0.0;
 };
@@ -75,7 +75,7 @@ struct RsuFrameRecord {
   double distance = 0.0;       ///< m, vehicle to RSU
   bool neighbours = false;     ///< another road user within 10 m of the ego vehicle
   bool found = false;          ///< a fix was sent
-  sim::Refusal refusal = sim::Refusal::kNone;
+  roadside::Refusal refusal = roadside::Refusal::kNone;
   double error = 0.0;          ///< m, planar, when found
   double ideal_error = -1.0;   ///< m, the ideal twin's fix on the same frame (< 0: none or not run)
   std::size_t fit_points = 0;  ///< points the L-shape fit had

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "coloc/core/time.hpp"
-#include "coloc/sim/lshape_fit.hpp"
+#include "coloc/roadside/lshape_fit.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 
 struct RoadsidePerceptionConfig {
   double background_distance = 0.15;  ///< m; a point this close to the reference frame is background
@@ -112,4 +112,4 @@ class RoadsidePerception {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

@@ -1,4 +1,4 @@
-#include "coloc/sim/lshape_fit.hpp"
+#include "coloc/roadside/lshape_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "coloc/core/error.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 
 namespace {
 
@@ -161,4 +161,4 @@ AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen:
   return box;
 }
 
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

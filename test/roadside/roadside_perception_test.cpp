@@ -1,4 +1,4 @@
-// The paper's roadside pipeline on the twin: a car with side mirrors drives past an RSU 2 m high; what
+// The paper's roadside pipeline on frames of the twin: a car with side mirrors drives past an RSU 2 m high; what
 // do the true-size alignment and the 0.8 m height cut buy over the plain L-shape centre?
 #include <gtest/gtest.h>
 
@@ -8,11 +8,13 @@
 #include "coloc/core/error.hpp"
 #include "coloc/sim/error_sources.hpp"
 #include "coloc/sim/lidar_model.hpp"
-#include "coloc/sim/roadside_perception.hpp"
+#include "coloc/roadside/roadside_perception.hpp"
 #include "coloc/sim/vehicle_body.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 namespace {
+
+using namespace coloc::sim;  // the twin makes the frames
 
 struct Variant {
   bool cut, align;
@@ -249,4 +251,4 @@ TEST_F(LineOfSight, AFitTurnedAwayFromTheCamHeadingIsRefused) {
 }
 
 }  // namespace
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

@@ -1,4 +1,4 @@
-#include "coloc/sim/roadside_perception.hpp"
+#include "coloc/roadside/roadside_perception.hpp"
 
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
@@ -10,7 +10,7 @@
 
 #include "coloc/core/error.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 
 struct RoadsidePerception::Impl {
   RoadsidePerceptionConfig config;
@@ -305,4 +305,4 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   return finish(Refusal::kNone);
 }
 
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

@@ -4,9 +4,9 @@
 #include <random>
 
 #include "coloc/core/error.hpp"
-#include "coloc/sim/lshape_fit.hpp"
+#include "coloc/roadside/lshape_fit.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 namespace {
 
 constexpr double kLength = 4.5, kWidth = 1.8;
@@ -158,4 +158,4 @@ TEST(LShapeFit, TooFewPointsIsAnError) {
 }
 
 }  // namespace
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

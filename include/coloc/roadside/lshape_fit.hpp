@@ -6,7 +6,7 @@
 #include <array>
 #include <vector>
 
-namespace coloc::sim {
+namespace coloc::roadside {
 
 enum class LShapeCriterion {
   kArea,       ///< smallest rectangle: biased towards the diagonal when one L is seen (kept for comparison)
@@ -54,4 +54,4 @@ struct AlignedBox {
 AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& lidar,
                             double length, double width, double heading_prior);
 
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

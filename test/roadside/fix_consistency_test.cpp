@@ -1,9 +1,9 @@
 // Consistency over frames: a fix must agree with the RSU's track of the vehicle, carried by the CAM's velocity.
 #include <gtest/gtest.h>
 
-#include "coloc/sim/fix_consistency.hpp"
+#include "coloc/roadside/fix_consistency.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 namespace {
 
 constexpr Stamp kFrame = 100'000'000;  // 10 Hz
@@ -44,4 +44,4 @@ TEST(FixConsistency, InABendTheMeanOfTheTwoVelocitiesCarriesTheFix) {
 }
 
 }  // namespace
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

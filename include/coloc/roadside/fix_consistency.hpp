@@ -11,7 +11,7 @@
 
 #include "coloc/core/time.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 
 class FixConsistency {
  public:
@@ -37,4 +37,4 @@ class FixConsistency {
   std::optional<Candidate> track_, previous_;
 };
 
-}  // namespace coloc::sim
+}  // namespace coloc::roadside

@@ -1,6 +1,6 @@
-#include "coloc/sim/fix_consistency.hpp"
+#include "coloc/roadside/fix_consistency.hpp"
 
-namespace coloc::sim {
+namespace coloc::roadside {
 
 bool FixConsistency::near(const Candidate& from, const Candidate& to, double max_dt) const {
   const double dt = toSeconds(to.stamp - from.stamp);
@@ -19,4 +19,4 @@ bool FixConsistency::agrees(Stamp stamp, const Eigen::Vector2d& position, const 
   return ok;
 }
 
-}  // namespace coloc::sim
+}  // namespace coloc::roadside
