@@ -3,6 +3,8 @@
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,7 +19,7 @@ struct RoadsidePerception::Impl {
   RsuMount mount;
   pcl::PointCloud<pcl::PointXYZ>::Ptr background;
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-  Eigen::Matrix2d rotation;  ///< sensor x-y to map x-y
+  Eigen::Matrix3d rotation;  ///< sensor axes to map axes (yaw, pitch, roll)
 };
 
 namespace {
@@ -69,7 +71,9 @@ RoadsidePerception::RoadsidePerception(const std::vector<Eigen::Vector3f>& refer
   impl_->background = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (const auto& p : reference_frame) impl_->background->push_back({p.x(), p.y(), p.z()});
   impl_->tree.setInputCloud(impl_->background);
-  impl_->rotation = Eigen::Rotation2Dd(mount.yaw).toRotationMatrix();
+  impl_->rotation = (Eigen::AngleAxisd(mount.yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(mount.pitch, Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(mount.roll, Eigen::Vector3d::UnitX()))
+                        .toRotationMatrix();
 }
 
 RoadsidePerception::~RoadsidePerception() = default;
@@ -181,8 +185,9 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   std::vector<float> distance_sq(1);
   const double background_sq = c.background_distance * c.background_distance;
   for (const Eigen::Vector3f& p : frame) {
-    const Eigen::Vector2d xy = impl_->rotation * p.head<2>().cast<double>() + lidar;
-    const double height = p.z() + impl_->mount.position.z();
+    const Eigen::Vector3d in_map = impl_->rotation * p.cast<double>() + impl_->mount.position;
+    const Eigen::Vector2d xy = in_map.head<2>();
+    const double height = in_map.z();
     if (height < 0.05) continue;  // the road itself
     const bool near = (xy - reference).norm() <= c.search_radius;
     if (!near && !(c.attribute && inSector(xy, height))) continue;

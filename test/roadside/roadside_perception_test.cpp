@@ -181,6 +181,48 @@ TEST_F(Neighbours, ACarBumperToBumperMergesWithTheVehicleAndTheFrameIsRefusedAsT
   EXPECT_EQ(d.refusal, Refusal::kTooLarge) << toString(d.refusal);
 }
 
+// A LiDAR on a 6 m pole pitched 2 deg down towards the road, as poles' LiDARs are: the mount's tilt
+// levels its points. Left unlevelled, a point 30 m out is 1 m off in height and the height cut keeps
+// the wrong part of the car.
+TEST(RoadsidePerception, ATiltedLidarIsLevelledByItsMount) {
+  RayCaster world;
+  world.addMesh(groundRectangle({-20, -30}, {60, 30}));
+  world.addMesh(box({20, 16, 0}, {80, 1, 8}));
+  const VehicleBody car;
+  const int car_mesh = world.addMesh(car.mesh(500, 500, 0));
+  world.commit();
+  RsuMount tilted;
+  tilted.position = {0.0, -6.0, 6.0};
+  tilted.pitch = 2.0 * M_PI / 180.0;
+  const Eigen::Isometry3d pose = Eigen::Translation3d(tilted.position) * Eigen::AngleAxisd(tilted.pitch, Eigen::Vector3d::UnitY());
+  const auto sensor = [&](double) { return pose; };
+  RandomEngine rng(6);
+  std::vector<Eigen::Vector3f> reference;
+  for (const LidarPoint& p : scanSweep(vlp32c(), world, sensor, rng)) reference.push_back(p.position);
+  RsuMount level = tilted;
+  level.pitch = 0.0;  // the tilt not known
+  const RoadsidePerception knows(reference, tilted), ignores(reference, level);
+  int found_known = 0, found_ignored = 0;
+  double error_known = 0.0, error_ignored = 0.0;
+  for (double x : {18.0, 22.0, 26.0, 30.0}) {
+    world.updateMesh(car_mesh, car.mesh(x, 0.0, 0.0));
+    world.commit();
+    std::vector<Eigen::Vector3f> frame;
+    for (const LidarPoint& p : scanSweep(vlp32c(), world, sensor, rng)) frame.push_back(p.position);
+    const VehicleDetection a = knows.detect(frame, 0, {x + 0.2, -0.2}, 0.0, car.length, car.width);
+    const VehicleDetection b = ignores.detect(frame, 0, {x + 0.2, -0.2}, 0.0, car.length, car.width);
+    if (a.found) ++found_known, error_known += (a.position - Eigen::Vector2d(x, 0.0)).norm();
+    if (b.found) ++found_ignored, error_ignored += (b.position - Eigen::Vector2d(x, 0.0)).norm();
+  }
+  std::printf("tilted 2 deg: levelled %d found, mean %.3f m; unlevelled %d found, mean %.3f m\n", found_known,
+              found_known ? error_known / found_known : -1.0, found_ignored, found_ignored ? error_ignored / found_ignored : -1.0);
+  // Levelled: 3 of the 4 frames give a fix (from 6 m up, at 22 m the few beams on the lower body fit
+  // away from the CAM position: the high-mount fit is a question of its own), within 5 cm on average.
+  ASSERT_GE(found_known, 3);
+  EXPECT_LT(error_known / found_known, 0.15);
+  EXPECT_LT(found_ignored, found_known);
+}
+
 // An RSU beside a street, 28 m from a car in the ego lane, something on the line of sight between them;
 // the LiDAR on a 2 m mast (the paper's) or an 8 m pole (an intersection's).
 class LineOfSight : public ::testing::Test {
