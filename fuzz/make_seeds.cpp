@@ -20,6 +20,7 @@
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/mcap_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
+#include "coloc/io/ros_node_interfaces.hpp"
 
 namespace fs = std::filesystem;
 using Bytes = std::vector<std::uint8_t>;
@@ -112,6 +113,19 @@ void cdrSeeds(const fs::path& recording) {
   pose.header = {1'700'000'000'000'000'000LL, "map"};
   pose.measurement.covariance.diagonal() << 0.01, 0.01, 1e9, 1e9, 1e9, 0.1;
   seed("cdr_fuzzer", "pose_cov", coloc::io::encodePoseWithCovarianceStamped(pose), static_cast<int>(MessageKind::kPoseWithCovarianceStamped));
+  // The live node's service requests and replies and its diagnostics, as coloc encodes them.
+  seed("node_interfaces_fuzzer", "set_bool_request", coloc::io::encodeSetBoolRequest(true), 0);
+  seed("node_interfaces_fuzzer", "set_bool_response", coloc::io::encodeSetBoolResponse({true, "activated"}), 1);
+  seed("node_interfaces_fuzzer", "align_request", coloc::io::encodePoseAlignRequest(pose), 2);
+  coloc::io::PoseAlignResponse aligned;
+  aligned.success = aligned.reliable = true;
+  aligned.pose = pose;
+  seed("node_interfaces_fuzzer", "align_response", coloc::io::encodePoseAlignResponse(aligned), 3);
+  coloc::io::DiagnosticArray diagnostics;
+  diagnostics.header.stamp = pose.header.stamp;
+  diagnostics.status.push_back({coloc::io::DiagnosticStatus::kWarn, "localization: ekf_localizer", "[WARN]process is not activated", "coloc",
+                                {{"is_activated", "False"}}});
+  seed("node_interfaces_fuzzer", "diagnostics", coloc::io::encodeDiagnosticArray(diagnostics), 4);
   seed("cdr_fuzzer", "pose", coloc::io::encodePoseStamped(pose), static_cast<int>(MessageKind::kPoseStamped));
   coloc::io::StampedTwist twist;
   twist.header = pose.header;
