@@ -1,6 +1,7 @@
 #include "coloc/live/live_localizer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -290,6 +291,7 @@ struct LiveLocalizer::Impl {
         event(service + ": " + response.message);
       } catch (const std::exception& e) {
         response.message = e.what();
+        event(service + ": request refused: " + response.message);
       }
       respond(io::encodeSetBoolResponse(response));
     });
@@ -406,7 +408,14 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
       io::PoseAlignResponse refused;
       try {
         io::StampedPose pose = io::decodePoseAlignRequest(request.data(), request.size());
+        // Whoever calls may send anything: NDT is started only from a finite pose with a usable rotation.
+        const Pose& p = pose.measurement.pose;
+        if (!p.position.allFinite() || !p.orientation.coeffs().allFinite() || std::abs(p.orientation.norm() - 1.0) > 1e-3)
+          throw Error("the pose is not finite or its quaternion is not of norm 1");
+        pose.measurement.pose.orientation.normalize();
         std::lock_guard<std::mutex> lock(d.align_mutex);
+        // A search takes about a second: a caller that floods the service gets refusals, not a queue.
+        if (d.align_queue.size() >= 4) throw Error("four alignments are already waiting");
         d.align_queue.emplace_back(std::move(pose), std::move(respond));
         d.align_wake.notify_one();
         return;

@@ -1,5 +1,8 @@
 #include "stamp_clock.hpp"
 
+#include <algorithm>
+#include <vector>
+
 namespace coloc::live {
 
 StampClock::StampClock(pipeline::ClockMode mode, double tolerance, double same_within)
@@ -13,17 +16,32 @@ void StampClock::reset() {
   separate_ = mode_ == pipeline::ClockMode::kSeparate;
   have_offset_ = false;
   offset_ = 0;
+  recent_.clear();
 }
+
+namespace {
+constexpr std::size_t kKept = 64;                        // delays kept: a few seconds of inputs
+constexpr Duration kNearMedian = 1'000'000'000LL;        // a delay this far below the median is not one
+}  // namespace
 
 void StampClock::observe(Stamp arrival, Stamp stamp) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Duration delay = arrival - stamp;
-  if (!decided_) {
+  recent_.push_back(arrival - stamp);
+  if (recent_.size() > kKept) recent_.pop_front();
+  std::vector<Duration> sorted(recent_.begin(), recent_.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const Duration median = sorted[sorted.size() / 2];
+  if (mode_ == pipeline::ClockMode::kAuto) {
     decided_ = true;
-    separate_ = delay < -tolerance_ || delay > same_within_;
+    separate_ = median < -tolerance_ || median > same_within_;
   }
   if (!separate_) return;
-  if (!have_offset_ || delay < offset_) offset_ = delay;
+  // The smallest delay among those near the median: the least-delayed message, not an outlier.
+  Duration smallest = median;
+  for (const Duration d : recent_)
+    if (d >= median - kNearMedian && d < smallest) smallest = d;
+  // Never later than before (the clock would go back), unless the old offset's messages are long gone.
+  if (!have_offset_ || smallest < offset_ || offset_ < median - kNearMedian) offset_ = smallest;
   have_offset_ = true;
 }
 

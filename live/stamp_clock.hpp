@@ -4,7 +4,10 @@
 // player's /clock is the recorder's wall clock (the nav2 recording: stamps near 924 s, /clock near
 // 1.78e9 s). As `coloc fuse` does offline (replay.clock), such stamps are recognised and the node's time
 // is moved onto their clock by the smallest delay seen: every message arrives after it was stamped, and
-// the least-delayed one arrived the moment it was stamped.
+// the least-delayed one arrived the moment it was stamped. Over the recent inputs only, and only among
+// delays near their median: one message stamped far off (a bad clock, a hostile sender) neither decides
+// the mode nor moves the node's time.
+#include <deque>
 #include <mutex>
 
 #include "coloc/core/time.hpp"
@@ -34,6 +37,7 @@ class StampClock {
   mutable std::mutex mutex_;
   bool decided_ = false, separate_ = false, have_offset_ = false;
   Duration offset_ = 0;
+  std::deque<Duration> recent_;  // the last delays (arrival - stamp)
 };
 
 }  // namespace coloc::live

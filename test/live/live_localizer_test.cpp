@@ -8,8 +8,11 @@
 #include <chrono>
 #include <cmath>
 #include <thread>
+#include <vector>
+#include <mutex>
 
 #include "coloc/io/ros_messages.hpp"
+#include "coloc/io/ros_node_interfaces.hpp"
 #include "coloc/rsu_client/dds_node.hpp"
 
 namespace coloc::live {
@@ -80,6 +83,57 @@ TEST(LiveLocalizer, MalformedAndInvalidSamplesAreCountedAndTheNodeKeepsRunning) 
   EXPECT_EQ(s.report.fixes.at("rsu_a").out_of_coverage, 1u);
   EXPECT_EQ(s.report.fixes.at("rsu_a").passed_checks, 1u);
   localizer.stop();
+}
+
+// Whoever calls the node's services may send anything: a truncated request, a pose of NaN, a flag that
+// is not a boolean. Each gets a refusal as its reply, and the node goes on serving.
+TEST(LiveLocalizer, MalformedServiceRequestsAreRefusedAndTheNodeGoesOnServing) {
+  LiveOptions options;
+  options.config.live.align_service = "/test/ndt_align_srv";
+  options.config.live.ekf_trigger_service = "/test/trigger_node";
+  options.dds.domain = 78;
+  options.dds.loopback_only = true;
+  std::vector<std::string> events;
+  std::mutex mutex;
+  options.on_event = [&](const std::string& line) {
+    std::lock_guard<std::mutex> lock(mutex);
+    events.push_back(line);
+  };
+  LiveLocalizer localizer(options);
+  rsu_client::DdsConfig dds;
+  dds.domain = 78;
+  dds.loopback_only = true;
+  dds.participant_name = "caller";
+  rsu_client::DdsNode node(dds);
+  auto align = node.client("/test/ndt_align_srv", io::kPoseAlignServiceType);
+  auto trigger = node.client("/test/trigger_node", io::kSetBoolType);
+  ASSERT_TRUE(align.waitForServer(10.0) && trigger.waitForServer(10.0));
+
+  io::StampedPose nan;
+  nan.header = {rsu_client::systemNow(), "map"};
+  nan.measurement.pose.position = {std::nan(""), 0.0, 0.0};
+  const io::Bytes whole = io::encodePoseAlignRequest(nan);
+  for (const io::Bytes& request : {whole, io::Bytes(whole.begin(), whole.begin() + 30)}) {
+    const auto reply = align.call(request, 10.0);
+    ASSERT_TRUE(reply.has_value());
+    EXPECT_FALSE(io::decodePoseAlignResponse(reply->data(), reply->size()).success);
+  }
+  const auto refused = trigger.call({0, 1, 0, 0, 7}, 10.0);
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_FALSE(io::decodeSetBoolResponse(refused->data(), refused->size()).success);
+  // A good request still gets its answer: without a map NDT cannot align, and says so.
+  nan.measurement.pose.position.x() = 1.0;
+  const auto reply = align.call(io::encodePoseAlignRequest(nan), 10.0);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(io::decodePoseAlignResponse(reply->data(), reply->size()).success);
+  const auto on = trigger.call(io::encodeSetBoolRequest(true), 10.0);
+  ASSERT_TRUE(on.has_value());
+  EXPECT_TRUE(io::decodeSetBoolResponse(on->data(), on->size()).success);
+  localizer.stop();
+  std::lock_guard<std::mutex> lock(mutex);
+  int refusals = 0;
+  for (const auto& e : events) refusals += e.find("request refused") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(refusals, 3) << "the NaN pose, the truncated request, the flag that is not a boolean";
 }
 
 }  // namespace

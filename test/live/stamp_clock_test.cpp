@@ -50,5 +50,19 @@ TEST(StampClock, AConfiguredModeIsNotGuessed) {
   EXPECT_EQ(separate.toStampClock(kWall + 5'000'000), kWall);
 }
 
+TEST(StampClock, OneMessageStampedFarOffNeitherDecidesTheModeNorMovesTheTime) {
+  StampClock clock(pipeline::ClockMode::kAuto, 0.05);
+  clock.observe(kWall, kSim);  // the first input, stamped on a simulator's clock
+  for (int i = 1; i <= 5; ++i) clock.observe(kWall + i * 100'000'000 + 10'000'000, kWall + i * 100'000'000);
+  EXPECT_FALSE(clock.separate()) << "the inputs' stamps are on the node's clock";
+  StampClock sim(pipeline::ClockMode::kAuto, 0.05);
+  const Duration apart = kWall - kSim;
+  for (int i = 0; i < 10; ++i) sim.observe(kSim + i * 100'000'000 + apart + 20'000'000, kSim + i * 100'000'000);
+  const Stamp before = sim.toStampClock(kWall + 2'000'000'000LL);
+  sim.observe(kSim + 1'000'000'000 + apart, kSim + 1'000'000'000 + 3600'000'000'000LL);  // stamped an hour ahead
+  EXPECT_EQ(sim.toStampClock(kWall + 2'000'000'000LL), before);
+  EXPECT_EQ(sim.offset(), apart + 20'000'000);
+}
+
 }  // namespace
 }  // namespace coloc::live
