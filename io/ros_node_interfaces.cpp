@@ -1,242 +1,230 @@
-// The few fields of these types are written and read directly, with every length checked against the
-// bytes present: no generated code is needed for them.
+// The few fields of these types are read and written with Fast CDR directly, after the same layout
+// walk every other decoder runs (cdr_check.hpp): every length checked against the bytes present, each
+// string NUL-terminated UTF-8, booleans 0 or 1, the field named in the error.
 #include "coloc/io/ros_node_interfaces.hpp"
 
-#include <cmath>
-#include <cstring>
+#include <functional>
 
-#include "coloc/core/error.hpp"
+#include "cdr_codec.hpp"
 
 namespace coloc::io {
 namespace {
 
-// XCDR1, little endian; alignment relative to the body (after the 4-byte encapsulation header).
-class Writer {
- public:
-  Writer() : bytes_{0x00, 0x01, 0x00, 0x00} {}
-  void u8(std::uint8_t v) { bytes_.push_back(v); }
-  void boolean(bool v) { u8(v ? 1 : 0); }
-  void u32(std::uint32_t v) {
-    align(4);
-    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void f64(double v) {
-    align(8);
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<std::uint8_t>(bits >> (8 * i)));
-  }
-  void string(const std::string& s, const char* type, const char* field) {
-    if (s.find('\0') != std::string::npos) throw Error(std::string(type) + ": " + field + " holds a NUL character");
-    u32(static_cast<std::uint32_t>(s.size() + 1));
-    bytes_.insert(bytes_.end(), s.begin(), s.end());
-    bytes_.push_back(0);
-  }
-  void header(const Header& h, const char* type) {
-    if (h.stamp < 0 || h.stamp / kNanosPerSecond > 0x7fffffffLL) throw Error(std::string(type) + ": header.stamp does not fit builtin_interfaces/Time");
-    u32(static_cast<std::uint32_t>(h.stamp / kNanosPerSecond));
-    u32(static_cast<std::uint32_t>(h.stamp % kNanosPerSecond));
-    string(h.frame_id, type, "header.frame_id");
-  }
-  void poseWithCovarianceStamped(const StampedPose& p, const char* type) {
-    header(p.header, type);
-    const Pose& pose = p.measurement.pose;
-    for (double v : {pose.position.x(), pose.position.y(), pose.position.z(), pose.orientation.x(), pose.orientation.y(),
-                     pose.orientation.z(), pose.orientation.w()})
-      f64(v);
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c) f64(p.measurement.covariance(r, c));
-  }
-  Bytes take() { return std::move(bytes_); }
+using detail::CdrChecker;
+using detail::CdrFormatError;
+using eprosima::fastcdr::Cdr;
 
- private:
-  void align(std::size_t n) {
-    while ((bytes_.size() - 4) % n != 0) bytes_.push_back(0);
-  }
-  Bytes bytes_;
-};
+constexpr const char* kSetBoolRequestType = "std_srvs/srv/SetBool_Request";
+constexpr const char* kSetBoolResponseType = "std_srvs/srv/SetBool_Response";
+constexpr const char* kAlignRequestType = "autoware_internal_localization_msgs/srv/PoseWithCovarianceStamped_Request";
+constexpr const char* kAlignResponseType = "autoware_internal_localization_msgs/srv/PoseWithCovarianceStamped_Response";
 
-class Reader {
- public:
-  Reader(const std::uint8_t* data, std::size_t size, const char* type) : data_(data), size_(size), type_(type) {
-    if (size < 4 || data == nullptr) fail("the encapsulation header", "shorter than 4 bytes");
-    if (data[0] != 0 || data[1] > 1) fail("the encapsulation header", "not plain CDR (00 00 or 00 01)");
-    little_ = data[1] == 1;
-    at_ = 4;
-  }
-  std::uint8_t u8(const char* field) {
-    need(1, field);
-    return data_[at_++];
-  }
-  bool boolean(const char* field) {
-    const std::uint8_t v = u8(field);
-    if (v > 1) fail(field, "is " + std::to_string(v) + ", not a boolean");
-    return v == 1;
-  }
-  std::uint32_t u32(const char* field) {
-    align(4);
-    need(4, field);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(data_[at_ + (little_ ? i : 3 - i)]) << (8 * i);
-    at_ += 4;
-    return v;
-  }
-  double f64(const char* field) {
-    align(8);
-    need(8, field);
-    std::uint64_t bits = 0;
-    for (int i = 0; i < 8; ++i) bits |= static_cast<std::uint64_t>(data_[at_ + (little_ ? i : 7 - i)]) << (8 * i);
-    at_ += 8;
-    double v;
-    std::memcpy(&v, &bits, sizeof v);
-    return v;
-  }
-  std::string string(const char* field) {
-    const std::uint32_t length = u32(field);
-    if (length == 0) fail(field, "has length 0 (a CDR string holds at least its NUL)");
-    need(length, field);
-    if (data_[at_ + length - 1] != 0) fail(field, "is not NUL-terminated");
-    std::string s(reinterpret_cast<const char*>(data_ + at_), length - 1);
-    if (s.find('\0') != std::string::npos) fail(field, "holds a NUL character");
-    at_ += length;
-    return s;
-  }
-  /// A sequence length, each element at least `min_size` bytes.
-  std::uint32_t sequence(std::size_t min_size, const char* field) {
-    const std::uint32_t n = u32(field);
-    if (static_cast<std::uint64_t>(n) * min_size > size_ - at_) fail(field, std::to_string(n) + " elements do not fit the bytes left");
-    return n;
-  }
-  Header header() {
-    Header h;
-    const auto sec = static_cast<std::int32_t>(u32("header.stamp.sec"));
-    const std::uint32_t nanosec = u32("header.stamp.nanosec");
-    if (nanosec >= kNanosPerSecond) fail("header.stamp.nanosec", std::to_string(nanosec) + " is not below 1e9");
-    h.stamp = static_cast<Stamp>(sec) * kNanosPerSecond + nanosec;
-    h.frame_id = string("header.frame_id");
-    return h;
-  }
-  StampedPose poseWithCovarianceStamped() {
-    StampedPose p;
-    p.header = header();
-    double v[7];
-    for (double& x : v) x = f64("pose.pose");
-    p.measurement.stamp = p.header.stamp;
-    p.measurement.pose.position = {v[0], v[1], v[2]};
-    p.measurement.pose.orientation = Eigen::Quaterniond(v[6], v[3], v[4], v[5]);
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c) p.measurement.covariance(r, c) = f64("pose.covariance");
-    return p;
-  }
-  [[noreturn]] void fail(const char* field, const std::string& why) const { throw Error(std::string(type_) + ": " + field + " " + why); }
+// ---- layout walks ----
 
- private:
-  void align(std::size_t n) {
-    while ((at_ - 4) % n != 0) ++at_;
+void checkHeader(CdrChecker& c) {
+  c.primitive(4, "header.stamp.sec");
+  const std::uint32_t nanosec = c.uint32("header.stamp.nanosec");
+  if (nanosec >= kNanosPerSecond) throw CdrFormatError("header.stamp.nanosec " + std::to_string(nanosec) + " is not below 1e9");
+  c.string("header.frame_id");
+}
+void checkPose(CdrChecker& c) {
+  checkHeader(c);
+  c.primitives(8, 7, "pose.pose");
+  c.primitives(8, 36, "pose.covariance");
+}
+void checkSetBoolRequest(CdrChecker& c) { c.boolean("data"); }
+void checkSetBoolResponse(CdrChecker& c) {
+  c.boolean("success");
+  c.string("message");
+}
+void checkAlignResponse(CdrChecker& c) {
+  c.boolean("success");
+  c.boolean("reliable");
+  checkPose(c);
+}
+void checkDiagnosticArray(CdrChecker& c) {
+  checkHeader(c);
+  // Each status at least: level, three empty strings, an empty sequence.
+  const std::uint32_t n = c.sequenceLength(1 + 3 * 5 + 4, "status");
+  for (std::uint32_t i = 0; i < n; ++i) {
+    c.primitive(1, "status.level");
+    c.string("status.name");
+    c.string("status.message");
+    c.string("status.hardware_id");
+    const std::uint32_t values = c.sequenceLength(2 * 5, "status.values");
+    for (std::uint32_t k = 0; k < values; ++k) {
+      c.string("status.values.key");
+      c.string("status.values.value");
+    }
   }
-  void need(std::size_t n, const char* field) const {
-    if (at_ > size_ || size_ - at_ < n) fail(field, "is truncated");
+}
+
+// ---- Fast CDR ----
+
+// Checks the layout, then reads with Fast CDR; any refusal becomes coloc::Error naming the type.
+template <typename Result>
+Result decode(const std::uint8_t* data, std::size_t size, const char* type, detail::LayoutCheck check,
+              const std::function<Result(Cdr&)>& read) {
+  try {
+    detail::checkSerializedMessage(data, size, check);
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(const_cast<std::uint8_t*>(data)), size);
+    Cdr cdr(buffer, Cdr::DEFAULT_ENDIAN, Cdr::DDS_CDR);
+    cdr.read_encapsulation();
+    return read(cdr);
+  } catch (const CdrFormatError& e) {
+    detail::throwCodecError(type, e.what());
+  } catch (const eprosima::fastcdr::exception::Exception& e) {
+    detail::throwCodecError(type, std::string("Fast CDR: ") + e.what());
   }
-  const std::uint8_t* data_;
-  std::size_t size_, at_ = 0;
-  const char* type_;
-  bool little_ = true;
-};
+}
+
+Bytes encode(const char* type, const std::function<void(Cdr&)>& write) {
+  eprosima::fastcdr::FastBuffer buffer;  // grows as written
+  Cdr cdr(buffer, Cdr::LITTLE_ENDIANNESS, Cdr::DDS_CDR);
+  try {
+    cdr.serialize_encapsulation();
+    write(cdr);
+  } catch (const eprosima::fastcdr::exception::Exception& e) {
+    detail::throwCodecError(type, std::string("Fast CDR: ") + e.what());
+  }
+  const auto* begin = reinterpret_cast<const std::uint8_t*>(buffer.getBuffer());
+  return Bytes(begin, begin + cdr.getSerializedDataLength());
+}
+
+void writeString(Cdr& cdr, const std::string& s, const char* type, const char* field) {
+  if (s.find('\0') != std::string::npos) detail::throwCodecError(type, std::string(field) + " holds a NUL character");
+  cdr << s;
+}
+
+void writeHeader(Cdr& cdr, const Header& h, const char* type) {
+  if (h.stamp < 0 || h.stamp / kNanosPerSecond > 0x7fffffffLL) detail::throwCodecError(type, "header.stamp does not fit builtin_interfaces/Time");
+  cdr << static_cast<std::int32_t>(h.stamp / kNanosPerSecond) << static_cast<std::uint32_t>(h.stamp % kNanosPerSecond);
+  writeString(cdr, h.frame_id, type, "header.frame_id");
+}
+
+Header readHeader(Cdr& cdr) {
+  std::int32_t sec = 0;
+  std::uint32_t nanosec = 0;
+  Header h;
+  cdr >> sec >> nanosec >> h.frame_id;
+  h.stamp = static_cast<Stamp>(sec) * kNanosPerSecond + nanosec;
+  return h;
+}
+
+void writePose(Cdr& cdr, const StampedPose& p, const char* type) {
+  writeHeader(cdr, p.header, type);
+  const Pose& pose = p.measurement.pose;
+  cdr << pose.position.x() << pose.position.y() << pose.position.z() << pose.orientation.x() << pose.orientation.y() << pose.orientation.z()
+      << pose.orientation.w();
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) cdr << p.measurement.covariance(r, c);
+}
+
+StampedPose readPose(Cdr& cdr) {
+  StampedPose p;
+  p.header = readHeader(cdr);
+  double v[7];
+  for (double& x : v) cdr >> x;
+  p.measurement.stamp = p.header.stamp;
+  p.measurement.pose.position = {v[0], v[1], v[2]};
+  p.measurement.pose.orientation = Eigen::Quaterniond(v[6], v[3], v[4], v[5]);
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) cdr >> p.measurement.covariance(r, c);
+  return p;
+}
 
 }  // namespace
 
 Bytes encodeDiagnosticArray(const DiagnosticArray& message) {
-  Writer w;
-  w.header(message.header, kDiagnosticArrayType);
-  w.u32(static_cast<std::uint32_t>(message.status.size()));
-  for (const DiagnosticStatus& s : message.status) {
-    w.u8(s.level);
-    w.string(s.name, kDiagnosticArrayType, "status.name");
-    w.string(s.message, kDiagnosticArrayType, "status.message");
-    w.string(s.hardware_id, kDiagnosticArrayType, "status.hardware_id");
-    w.u32(static_cast<std::uint32_t>(s.values.size()));
-    for (const auto& [key, value] : s.values) {
-      w.string(key, kDiagnosticArrayType, "status.values.key");
-      w.string(value, kDiagnosticArrayType, "status.values.value");
+  return encode(kDiagnosticArrayType, [&](Cdr& cdr) {
+    writeHeader(cdr, message.header, kDiagnosticArrayType);
+    cdr << static_cast<std::uint32_t>(message.status.size());
+    for (const DiagnosticStatus& s : message.status) {
+      cdr << s.level;
+      writeString(cdr, s.name, kDiagnosticArrayType, "status.name");
+      writeString(cdr, s.message, kDiagnosticArrayType, "status.message");
+      writeString(cdr, s.hardware_id, kDiagnosticArrayType, "status.hardware_id");
+      cdr << static_cast<std::uint32_t>(s.values.size());
+      for (const auto& [key, value] : s.values) {
+        writeString(cdr, key, kDiagnosticArrayType, "status.values.key");
+        writeString(cdr, value, kDiagnosticArrayType, "status.values.value");
+      }
     }
-  }
-  return w.take();
+  });
 }
 
 DiagnosticArray decodeDiagnosticArray(const std::uint8_t* data, std::size_t size) {
-  Reader r(data, size, kDiagnosticArrayType);
-  DiagnosticArray out;
-  out.header = r.header();
-  const std::uint32_t n = r.sequence(1 + 3 * 5 + 4, "status");
-  for (std::uint32_t i = 0; i < n; ++i) {
-    DiagnosticStatus s;
-    s.level = r.u8("status.level");
-    if (s.level > DiagnosticStatus::kStale) r.fail("status.level", "is " + std::to_string(s.level) + ", not 0-3");
-    s.name = r.string("status.name");
-    s.message = r.string("status.message");
-    s.hardware_id = r.string("status.hardware_id");
-    const std::uint32_t values = r.sequence(2 * 5, "status.values");
-    for (std::uint32_t k = 0; k < values; ++k) {
-      std::string key = r.string("status.values.key");
-      s.values.emplace_back(std::move(key), r.string("status.values.value"));
+  return decode<DiagnosticArray>(data, size, kDiagnosticArrayType, checkDiagnosticArray, [](Cdr& cdr) {
+    DiagnosticArray out;
+    out.header = readHeader(cdr);
+    std::uint32_t n = 0;
+    cdr >> n;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      DiagnosticStatus s;
+      cdr >> s.level >> s.name >> s.message >> s.hardware_id;
+      if (s.level > DiagnosticStatus::kStale) throw CdrFormatError("status.level is " + std::to_string(s.level) + ", not 0-3");
+      std::uint32_t values = 0;
+      cdr >> values;
+      for (std::uint32_t k = 0; k < values; ++k) {
+        std::string key, value;
+        cdr >> key >> value;
+        s.values.emplace_back(std::move(key), std::move(value));
+      }
+      out.status.push_back(std::move(s));
     }
-    out.status.push_back(std::move(s));
-  }
-  return out;
+    return out;
+  });
 }
 
 Bytes encodeSetBoolRequest(bool data) {
-  Writer w;
-  w.boolean(data);
-  return w.take();
+  return encode(kSetBoolRequestType, [&](Cdr& cdr) { cdr << data; });
 }
 
 bool decodeSetBoolRequest(const std::uint8_t* data, std::size_t size) {
-  Reader r(data, size, "std_srvs/srv/SetBool_Request");
-  return r.boolean("data");
+  return decode<bool>(data, size, kSetBoolRequestType, checkSetBoolRequest, [](Cdr& cdr) {
+    bool b = false;
+    cdr >> b;
+    return b;
+  });
 }
 
 Bytes encodeSetBoolResponse(const SetBoolResponse& response) {
-  Writer w;
-  w.boolean(response.success);
-  w.string(response.message, "std_srvs/srv/SetBool_Response", "message");
-  return w.take();
+  return encode(kSetBoolResponseType, [&](Cdr& cdr) {
+    cdr << response.success;
+    writeString(cdr, response.message, kSetBoolResponseType, "message");
+  });
 }
 
 SetBoolResponse decodeSetBoolResponse(const std::uint8_t* data, std::size_t size) {
-  Reader r(data, size, "std_srvs/srv/SetBool_Response");
-  SetBoolResponse out;
-  out.success = r.boolean("success");
-  out.message = r.string("message");
-  return out;
+  return decode<SetBoolResponse>(data, size, kSetBoolResponseType, checkSetBoolResponse, [](Cdr& cdr) {
+    SetBoolResponse out;
+    cdr >> out.success >> out.message;
+    return out;
+  });
 }
 
 Bytes encodePoseAlignRequest(const StampedPose& request) {
-  Writer w;
-  w.poseWithCovarianceStamped(request, "autoware_internal_localization_msgs/srv/PoseWithCovarianceStamped_Request");
-  return w.take();
+  return encode(kAlignRequestType, [&](Cdr& cdr) { writePose(cdr, request, kAlignRequestType); });
 }
 
 StampedPose decodePoseAlignRequest(const std::uint8_t* data, std::size_t size) {
-  Reader r(data, size, "autoware_internal_localization_msgs/srv/PoseWithCovarianceStamped_Request");
-  return r.poseWithCovarianceStamped();
+  return decode<StampedPose>(data, size, kAlignRequestType, checkPose, readPose);
 }
 
 Bytes encodePoseAlignResponse(const PoseAlignResponse& response) {
-  Writer w;
-  w.boolean(response.success);
-  w.boolean(response.reliable);
-  w.poseWithCovarianceStamped(response.pose, "autoware_internal_localization_msgs/srv/PoseWithCovarianceStamped_Response");
-  return w.take();
+  return encode(kAlignResponseType, [&](Cdr& cdr) {
+    cdr << response.success << response.reliable;
+    writePose(cdr, response.pose, kAlignResponseType);
+  });
 }
 
 PoseAlignResponse decodePoseAlignResponse(const std::uint8_t* data, std::size_t size) {
-  Reader r(data, size, "autoware_internal_localization_msgs/srv/PoseWithCovarianceStamped_Response");
-  PoseAlignResponse out;
-  out.success = r.boolean("success");
-  out.reliable = r.boolean("reliable");
-  out.pose = r.poseWithCovarianceStamped();
-  return out;
+  return decode<PoseAlignResponse>(data, size, kAlignResponseType, checkAlignResponse, [](Cdr& cdr) {
+    PoseAlignResponse out;
+    cdr >> out.success >> out.reliable;
+    out.pose = readPose(cdr);
+    return out;
+  });
 }
 
 }  // namespace coloc::io
