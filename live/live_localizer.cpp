@@ -210,30 +210,29 @@ struct LiveLocalizer::Impl {
           });
         };
         break;
-      case pipeline::InputRole::kTwist: {
-        const fusion::SourceId source = pipe->addTwistSource(plan.source.empty() ? topic : plan.source);
-        t = addTopic(topic, ros_type);
-        callback = [this, t, kind, input, source, extra_delay](Bytes&& b, Stamp) {
-          receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
-            bool fallback = false;
-            TwistMeasurement twist = pipeline::twistFromMessage(io::decodeMessage(kind, bytes), input, config.messages, fallback);
-            const Stamp at = arrive(arrival, twist.stamp);
-            twist.stamp -= extra_delay;
-            pipe->pushTwist(source, twist, at);
-          });
-        };
-        break;
-      }
+      case pipeline::InputRole::kTwist:
       case pipeline::InputRole::kPose: {
-        const fusion::SourceId source = pipe->addPoseSource(plan.source.empty() ? topic : plan.source);
+        // Twists and poses alike: decoded, covariance completed, taken at their arrival on the stamps'
+        // clock, moved back by the input's additional delay, handed to their source.
+        const bool twist = plan.role == pipeline::InputRole::kTwist;
+        const std::string name = plan.source.empty() ? topic : plan.source;
+        const fusion::SourceId source = twist ? pipe->addTwistSource(name) : pipe->addPoseSource(name);
         t = addTopic(topic, ros_type);
-        callback = [this, t, kind, input, source, extra_delay](Bytes&& b, Stamp) {
+        callback = [this, t, kind, input, source, extra_delay, twist](Bytes&& b, Stamp) {
           receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
             bool fallback = false;
-            PoseMeasurement pose = pipeline::poseFromMessage(io::decodeMessage(kind, bytes), input, config.messages, fallback);
-            const Stamp at = arrive(arrival, pose.stamp);
-            pose.stamp -= extra_delay;
-            pipe->pushPose(source, pose, at);
+            const io::RosMessage message = io::decodeMessage(kind, bytes);
+            if (twist) {
+              TwistMeasurement m = pipeline::twistFromMessage(message, input, config.messages, fallback);
+              const Stamp at = arrive(arrival, m.stamp);
+              m.stamp -= extra_delay;
+              pipe->pushTwist(source, m, at);
+            } else {
+              PoseMeasurement m = pipeline::poseFromMessage(message, input, config.messages, fallback);
+              const Stamp at = arrive(arrival, m.stamp);
+              m.stamp -= extra_delay;
+              pipe->pushPose(source, m, at);
+            }
           });
         };
         break;
