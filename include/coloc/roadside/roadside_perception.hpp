@@ -42,7 +42,7 @@ struct RoadsidePerceptionConfig {
   int occlusion_points = 5;
   double occlusion_top = 1.2;  ///< m, the top of a car's lower body, when height_cut is off
   /// The fitted heading against the CAM's: a fit turned further than this put its box on the wrong faces
-  /// (real frames: fixes 69-73 cm off with headings 22-26 deg wrong). Refused beyond it; <= 0: no check.
+  /// (held-back real frames, the maintainers' measurement: fixes 69-73 cm off with headings 22-26 deg wrong). Refused beyond it; <= 0: no check.
   double max_heading_disagreement = 10.0 * M_PI / 180.0;  ///< rad
   /// The true-size box rests on the fitted corner nearest the LiDAR. With one face of the vehicle seen
   /// and no corner, that face's end is a corner only if the face is seen whole; one shorter than its side
