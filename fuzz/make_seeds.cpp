@@ -21,6 +21,7 @@
 #include "coloc/io/mcap_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/io/ros_node_interfaces.hpp"
+#include "coloc/io/v2x_messages.hpp"
 
 namespace fs = std::filesystem;
 using Bytes = std::vector<std::uint8_t>;
@@ -126,6 +127,14 @@ void cdrSeeds(const fs::path& recording) {
   diagnostics.status.push_back({coloc::io::DiagnosticStatus::kWarn, "localization: ekf_localizer", "[WARN]process is not activated", "coloc",
                                 {{"is_activated", "False"}}});
   seed("node_interfaces_fuzzer", "diagnostics", coloc::io::encodeDiagnosticArray(diagnostics), 4);
+  coloc::io::Cam cam;
+  cam.header = {1'700'000'001'000'000'000LL, "map"};
+  cam.station_id = 1002;
+  cam.reference = {12.0, -1.75};
+  cam.speed = 8.0;
+  cam.length = 4.7;
+  cam.width = 1.9;
+  seed("node_interfaces_fuzzer", "cam", coloc::io::encodeCam(cam), 5);
   seed("cdr_fuzzer", "pose", coloc::io::encodePoseStamped(pose), static_cast<int>(MessageKind::kPoseStamped));
   coloc::io::StampedTwist twist;
   twist.header = pose.header;

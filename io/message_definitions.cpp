@@ -60,6 +60,10 @@ const std::map<std::string, MsgSpec>& specs() {
       {"geometry_msgs/TransformStamped",
        {"std_msgs/Header header\nstring child_frame_id\nTransform transform\n", {"std_msgs/Header", "geometry_msgs/Transform"}}},
       {"tf2_msgs/TFMessage", {"geometry_msgs/TransformStamped[] transforms\n", {"geometry_msgs/TransformStamped"}}},
+      {"coloc_msgs/Cam",
+       {"std_msgs/Header header\nuint32 station_id\nfloat64 x\nfloat64 y\nfloat64 heading\nfloat64 speed\nfloat64 yaw_rate\n"
+        "float64 length\nfloat64 width\n",
+        {"std_msgs/Header"}}},
   };
   return table;
 }

@@ -72,9 +72,15 @@ struct LiveLocalizer::Impl {
   // The node's time on the header stamps' clock (stamp_clock.hpp): what the pipeline runs on.
   std::unique_ptr<StampClock> stamps;
   Stamp pipelineNow() const { return stamps->toStampClock(now()); }
-  /// An input stamped `stamp` that reached the node at `arrival` (node time), on the pipeline's clock.
-  Stamp arrive(Stamp arrival, Stamp stamp) {
-    stamps->observe(arrival, stamp);
+  /// An input stamped `stamp` that reached the node at `arrival` (node time), on the pipeline's clock;
+  /// none for one sent before the clock's last jump back, which is counted against its topic: taken,
+  /// it would start the filter on the old timeline.
+  std::optional<Stamp> arrive(std::size_t topic, Stamp arrival, Stamp stamp) {
+    if (!stamps->observe(arrival, stamp)) {
+      std::lock_guard<std::mutex> lock(mutex);
+      ++topics[topic].from_before_clock_jump;
+      return std::nullopt;
+    }
     const Stamp on_stamps = stamps->toStampClock(arrival);
     // On a clock of their own, no message arrives before it was stamped (as offline); on one clock a
     // message from the future is the filter's to refuse.
@@ -204,9 +210,9 @@ struct LiveLocalizer::Impl {
         if (!have_map) return false;
         t = addTopic(topic, ros_type);
         callback = [this, t](Bytes&& b, Stamp) {
-          receive(t, b, [this](const Bytes& bytes, Stamp arrival) {
+          receive(t, b, [this, t](const Bytes& bytes, Stamp arrival) {
             const io::PointCloud2 cloud = io::decodePointCloud2(bytes.data(), bytes.size());
-            pipe->pushScan(pipeline::toPointCloud(cloud), cloud.header.stamp, arrive(arrival, cloud.header.stamp));
+            if (const auto at = arrive(t, arrival, cloud.header.stamp)) pipe->pushScan(pipeline::toPointCloud(cloud), cloud.header.stamp, *at);
           });
         };
         break;
@@ -224,14 +230,14 @@ struct LiveLocalizer::Impl {
             const io::RosMessage message = io::decodeMessage(kind, bytes);
             if (twist) {
               TwistMeasurement m = pipeline::twistFromMessage(message, input, config.messages, fallback);
-              const Stamp at = arrive(arrival, m.stamp);
+              const auto at = arrive(t, arrival, m.stamp);
               m.stamp -= extra_delay;
-              pipe->pushTwist(source, m, at);
+              if (at) pipe->pushTwist(source, m, *at);
             } else {
               PoseMeasurement m = pipeline::poseFromMessage(message, input, config.messages, fallback);
-              const Stamp at = arrive(arrival, m.stamp);
+              const auto at = arrive(t, arrival, m.stamp);
               m.stamp -= extra_delay;
-              pipe->pushPose(source, m, at);
+              if (at) pipe->pushPose(source, m, *at);
             }
           });
         };
@@ -242,7 +248,7 @@ struct LiveLocalizer::Impl {
         callback = [this, t, kind, id = plan.rsu_id](Bytes&& b, Stamp) {
           receive(t, b, [&](const Bytes& bytes, Stamp arrival) {
             const rsu_client::RsuFix fix = pipeline::fixFromMessage(io::decodeMessage(kind, bytes), id);
-            pipe->pushFix(fix, arrive(arrival, fix.stamp));
+            if (const auto at = arrive(t, arrival, fix.stamp)) pipe->pushFix(fix, *at);
           });
         };
         break;
@@ -440,7 +446,8 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
         // restarts): the stamps' clock is related afresh, and the pipeline sees the jump and starts the
         // filter again.
         const Stamp clock = io::decodeClock(bytes.data(), bytes.size());
-        if (clock + fromSeconds(1.0 / d.config.fusion.predict_frequency) < d.sim_now.load()) d.stamps->reset();
+        const Stamp before = d.sim_now.load();
+        if (clock + fromSeconds(1.0 / d.config.fusion.predict_frequency) < before) d.stamps->reset(before, clock);
         d.sim_now.store(clock);
       });
     });
@@ -468,11 +475,11 @@ LiveLocalizer::LiveLocalizer(LiveOptions options) : impl_(std::make_unique<Impl>
     const std::size_t t = d.addTopic(d.config.live.initial_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped");
     d.node->subscribe(d.config.live.initial_pose_topic, "geometry_msgs/msg/PoseWithCovarianceStamped", inputQos(d.config, 1),
                       [&d, t](Bytes&& b, Stamp) {
-                        d.receive(t, b, [&d](const Bytes& bytes, Stamp arrival) {
+                        d.receive(t, b, [&d, t](const Bytes& bytes, Stamp arrival) {
                           bool fallback = false;
                           const PoseMeasurement pose = pipeline::poseFromMessage(
                               io::decodeMessage(io::MessageKind::kPoseWithCovarianceStamped, bytes), nullptr, d.config.messages, fallback);
-                          d.pipe->pushInitialPose(pose, d.arrive(arrival, pose.stamp));
+                          if (const auto at = d.arrive(t, arrival, pose.stamp)) d.pipe->pushInitialPose(pose, *at);
                         });
                       });
     d.subscribed.insert(d.config.live.initial_pose_topic);
@@ -549,6 +556,8 @@ std::string LiveLocalizer::summaryJson() const {
   nlohmann::ordered_json j;
   j["mode"] = "live";
   j["clock"] = impl_->use_sim_time ? "/clock (simulation time)" : "system";
+  // How the header stamps were related to that clock at the end (stamp_clock.hpp).
+  j["stamps"] = impl_->stamps->separate() ? "on a clock of their own, offset " + formatSeconds(impl_->stamps->offset()) + " s" : "on the node's clock";
   auto& topics = j["topics"] = nlohmann::ordered_json::array();
   for (const TopicStatus& t : s.topics) {
     nlohmann::ordered_json o = {{"topic", t.topic},
@@ -559,6 +568,7 @@ std::string LiveLocalizer::summaryJson() const {
                                 {"sequence_gaps", t.sequence_gaps},
                                 {"dds_lost", t.lost},
                                 {"dds_rejected", t.rejected},
+                                {"from_before_clock_jump", t.from_before_clock_jump},
                                 {"longest_gap_s", t.longest_gap}};
     if (!t.first_error.empty()) o["first_error"] = t.first_error;
     topics.push_back(o);

@@ -7,11 +7,20 @@ namespace coloc::live {
 
 StampClock::StampClock(pipeline::ClockMode mode, double tolerance, double same_within)
     : mode_(mode), tolerance_(fromSeconds(tolerance)), same_within_(fromSeconds(same_within)) {
-  reset();
+  clear();
 }
 
-void StampClock::reset() {
+void StampClock::reset(Stamp from, Stamp to) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // The old relation, if there was one, tells the stale inputs apart: stamped on the old timeline.
+  after_jump_ = decided_ && (!separate_ || have_offset_) && from > to;
+  halfway_ = to + (from - to) / 2;
+  old_offset_ = separate_ ? offset_ : 0;
+  taken_since_jump_ = 0;
+  clear();
+}
+
+void StampClock::clear() {
   decided_ = mode_ != pipeline::ClockMode::kAuto;
   separate_ = mode_ == pipeline::ClockMode::kSeparate;
   have_offset_ = false;
@@ -22,10 +31,18 @@ void StampClock::reset() {
 namespace {
 constexpr std::size_t kKept = 64;                        // delays kept: a few seconds of inputs
 constexpr Duration kNearMedian = 1'000'000'000LL;        // a delay this far below the median is not one
+constexpr int kSettling = 16;                            // inputs after a jump back that end its watch
 }  // namespace
 
-void StampClock::observe(Stamp arrival, Stamp stamp) {
+bool StampClock::observe(Stamp arrival, Stamp stamp) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (after_jump_) {
+    // Stamped on the old timeline, or taken at an arrival read before the jump (another reader's
+    // thread): either way from before it. Once the new relation has enough inputs of its own, none
+    // from before is still on its way.
+    if (arrival >= halfway_ || stamp + old_offset_ > halfway_) return false;
+    if (++taken_since_jump_ >= kSettling) after_jump_ = false;
+  }
   recent_.push_back(arrival - stamp);
   if (recent_.size() > kKept) recent_.pop_front();
   std::vector<Duration> sorted(recent_.begin(), recent_.end());
@@ -35,7 +52,7 @@ void StampClock::observe(Stamp arrival, Stamp stamp) {
     decided_ = true;
     separate_ = median < -tolerance_ || median > same_within_;
   }
-  if (!separate_) return;
+  if (!separate_) return true;
   // The smallest delay among those near the median: the least-delayed message, not an outlier.
   Duration smallest = median;
   for (const Duration d : recent_)
@@ -43,6 +60,7 @@ void StampClock::observe(Stamp arrival, Stamp stamp) {
   // Never later than before (the clock would go back), unless the old offset's messages are long gone.
   if (!have_offset_ || smallest < offset_ || offset_ < median - kNearMedian) offset_ = smallest;
   have_offset_ = true;
+  return true;
 }
 
 Stamp StampClock::toStampClock(Stamp node_time) const {

@@ -88,6 +88,12 @@ InputPlan planInput(const std::string& topic, const std::string& ros_type, const
     use.note = "type not decoded by coloc";
   } else {
     use.role = defaultRole(topic, *use.kind, have_map, rsu.has_value(), use.note);
+    if (registry && *use.kind == io::MessageKind::kPointCloud2)
+      for (const rsu_client::RsuInfo& r : registry->rsus())
+        if (topic == rsu_client::roadsidePointsTopic(r.id)) {
+          use.role = InputRole::kIgnore;
+          use.note = "RSU " + r.id + "'s own LiDAR frames: coloc rsu-node's input, not the vehicle's scans";
+        }
     use.source = use.role == InputRole::kScan ? "ndt" : topic;
   }
   if (use.role == InputRole::kRsuFix) {

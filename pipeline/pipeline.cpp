@@ -43,6 +43,7 @@ struct InitialPoseInput {
 struct NdtResult {
   ndt::ScanOutcome outcome;
   Stamp scan_stamp;
+  std::uint64_t timeline;  ///< the pipeline's timeline when the scan was submitted (see Impl::timeline)
 };
 using Input = std::variant<ScanInput, TwistInput, PoseInput, FixInput, InitialPoseInput, NdtResult>;
 
@@ -77,7 +78,7 @@ constexpr std::size_t kKeptEvents = 50;
 // NDT on a thread of its own (live): one scan matched at a time; a newer scan replaces the one waiting.
 class NdtThread {
  public:
-  using Done = std::function<void(ndt::ScanOutcome, Stamp scan_stamp)>;
+  using Done = std::function<void(ndt::ScanOutcome, Stamp scan_stamp, std::uint64_t timeline)>;
   /// `use`: held while the source matches, so that the pipeline's own use of it (a heading search) waits.
   NdtThread(ndt::NdtPoseSource& source, std::mutex& use, Done done)
       : source_(source), use_(use), done_(std::move(done)), thread_([this] { run(); }) {}
@@ -90,10 +91,10 @@ class NdtThread {
     thread_.join();
   }
   /// False if a waiting scan was replaced.
-  bool submit(std::shared_ptr<const ndt::PointCloud> cloud, Stamp stamp, const fusion::Estimate& guess) {
+  bool submit(std::shared_ptr<const ndt::PointCloud> cloud, Stamp stamp, const fusion::Estimate& guess, std::uint64_t timeline) {
     std::lock_guard<std::mutex> lock(mutex_);
     const bool replaced = job_.has_value();
-    job_ = Job{std::move(cloud), stamp, guess};
+    job_ = Job{std::move(cloud), stamp, guess, timeline};
     wake_.notify_all();
     return !replaced;
   }
@@ -111,6 +112,7 @@ class NdtThread {
     std::shared_ptr<const ndt::PointCloud> cloud;
     Stamp stamp;
     fusion::Estimate guess;
+    std::uint64_t timeline;
   };
   void run() {
     for (;;) {
@@ -132,7 +134,7 @@ class NdtThread {
         counters_ = source_.counters();
         map_stats_ = source_.map().stats();
       }
-      done_(std::move(outcome), job.stamp);
+      done_(std::move(outcome), job.stamp, job.timeline);
     }
   }
   ndt::NdtPoseSource& source_;
@@ -180,6 +182,8 @@ struct Pipeline::Impl {
   Eigen::Isometry3d base_to_lidar = Eigen::Isometry3d::Identity();  // the configured extrinsic
   bool first_input_seen = false;
   Stamp clock = 0;
+  /// Counts the clock's jumps back: NDT's results from scans submitted before one are dropped.
+  std::uint64_t timeline = 0;
   bool clock_set = false;
   PipelineReport report;
   std::function<void(const fusion::Estimate&)> on_estimate;
@@ -227,8 +231,8 @@ struct Pipeline::Impl {
       ndt_id = addSource(kNdtSource, fusion::SourceKind::kPose);
       report.ndt_used = true;
       if (options.ndt_thread)
-        ndt_thread = std::make_unique<NdtThread>(*ndt, ndt_use, [this](ndt::ScanOutcome outcome, Stamp stamp) {
-          inbox.push(NdtResult{std::move(outcome), stamp}, now());
+        ndt_thread = std::make_unique<NdtThread>(*ndt, ndt_use, [this](ndt::ScanOutcome outcome, Stamp stamp, std::uint64_t line) {
+          inbox.push(NdtResult{std::move(outcome), stamp, line}, now());
         });
     }
     if (options.registry) {
@@ -360,6 +364,7 @@ struct Pipeline::Impl {
     event(formatSeconds(now) + " clock went back by " + formatSeconds(clock - now) + " s: the filter starts again" +
           (dropped ? " (" + std::to_string(dropped) + " inputs from before the jump dropped)" : std::string()));
     ++report.clock_resets;
+    ++timeline;
     report.inputs_dropped_by_reset += dropped;
     localizer.reset();
     initializer.reset();
@@ -473,11 +478,17 @@ struct Pipeline::Impl {
         else check_start = false;
       }
       if (ndt_thread) {
-        if (!ndt_thread->submit(std::move(scan->cloud), scan->stamp, *guess)) ++report.scans_superseded;
+        if (!ndt_thread->submit(std::move(scan->cloud), scan->stamp, *guess, timeline)) ++report.scans_superseded;
         return;
       }
       handle(ndt->process(scan->cloud, scan->stamp, guess->pose, guess->state[4], guess->state[5]), scan->stamp);
     } else if (auto* result = std::get_if<NdtResult>(&input)) {
+      // A scan matched across a jump back in time belongs to the timeline before it: its pose would
+      // start (or move) the filter there.
+      if (result->timeline != timeline) {
+        ++report.inputs_dropped_by_reset;
+        return;
+      }
       handle(result->outcome, result->scan_stamp);
     } else if (auto* twist = std::get_if<TwistInput>(&input)) {
       // A twist that measures speed (odometry, not an IMU) is scaled by what NDT taught about it, and

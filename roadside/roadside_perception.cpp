@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "coloc/core/error.hpp"
+#include "coloc/roadside/road_surface.hpp"
 
 namespace coloc::roadside {
 
@@ -20,6 +21,7 @@ struct RoadsidePerception::Impl {
   pcl::PointCloud<pcl::PointXYZ>::Ptr background;
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   Eigen::Matrix3d rotation;  ///< sensor axes to map axes (yaw, pitch, roll)
+  RoadSurface road;          ///< the local road's height, map frame
 };
 
 namespace {
@@ -74,7 +76,16 @@ RoadsidePerception::RoadsidePerception(const std::vector<Eigen::Vector3f>& refer
   impl_->rotation = (Eigen::AngleAxisd(mount.yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(mount.pitch, Eigen::Vector3d::UnitY()) *
                      Eigen::AngleAxisd(mount.roll, Eigen::Vector3d::UnitX()))
                         .toRotationMatrix();
+  if (config.local_road) {
+    std::vector<Eigen::Vector3d> in_map;
+    in_map.reserve(reference_frame.size());
+    for (const auto& p : reference_frame) in_map.push_back(impl_->rotation * p.cast<double>() + mount.position);
+    impl_->road = RoadSurface(in_map, mount.position.head<2>(), config.road);
+  }
 }
+
+double RoadsidePerception::roadHeight(const Eigen::Vector2d& xy) const { return impl_->road.height(xy); }
+std::optional<GroundPlane> RoadsidePerception::roadPlane() const { return impl_->road.plane(); }
 
 RoadsidePerception::~RoadsidePerception() = default;
 RoadsidePerception::RoadsidePerception(RoadsidePerception&&) noexcept = default;
@@ -93,6 +104,7 @@ const char* toString(Refusal r) {
     case Refusal::kCornerNotSeen: return "one face seen, no corner to place the vehicle on";
     case Refusal::kBeyondOracleLimit: return "beyond the oracle limit from the true position (analysis bound)";
     case Refusal::kHeadingDisagrees: return "fitted heading away from the CAM's";
+    case Refusal::kTooFewPoints: return "too few returns on the vehicle's body to fit";
   }
   return "?";
 }
@@ -156,9 +168,12 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // The line of sight from the LiDAR to the top of the body part the fit uses, at the footprint's
   // nearest range: a point below it at its own range hides nothing of that part (from a high mount,
   // a pedestrian or an uneven road between; from a 2 m mast, a car still does).
-  const double lidar_height = impl_->mount.position.z();
-  const double sight_top = c.height_cut ? c.cut_height : c.occlusion_top;
-  const auto sightHeight = [&](double range) { return lidar_height + (sight_top - lidar_height) * range / std::max(footprint_range, 1e-3); };
+  // Heights here are the map's (over the mount's road datum): the road under the vehicle need not be
+  // the road under the pole.
+  const RoadSurface& road = impl_->road;
+  const double lidar_z = impl_->mount.position.z();
+  const double sight_top = road.height(reference) + (c.height_cut ? c.cut_height : c.occlusion_top);
+  const auto sightHeight = [&](double range) { return lidar_z + (sight_top - lidar_z) * range / std::max(footprint_range, 1e-3); };
   // A point whose bearing is further off the expected one than the sector reaches on either side is
   // outside it: a cosine against a bound rules out most near points without the two arc tangents and
   // the wrap. The margin, a microradian, is far above either way's rounding (1e-15), so every point
@@ -166,12 +181,12 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   const double reach = std::max(-bearing_lo, bearing_hi) + 1e-6;
   const double cos_reach = reach < M_PI ? std::cos(reach) : -2.0;
   const Eigen::Vector2d toward(std::cos(bearing0), std::sin(bearing0));
-  const auto inSector = [&](const Eigen::Vector2d& xy, double height) {
+  const auto inSector = [&](const Eigen::Vector2d& xy, double z) {
     // Range first: most of a frame lies beyond the vehicle, and needs no bearing.
     const Eigen::Vector2d d = xy - lidar;
     const double range = d.norm();
     if (!(range < footprint_range - kOccluderClearance)) return false;
-    if (height < sightHeight(range)) return false;
+    if (z < sightHeight(range)) return false;
     if (d.dot(toward) < cos_reach * range) return false;
     const double b = wrapAngle(std::atan2(xy.y() - lidar.y(), xy.x() - lidar.x()) - bearing0);
     return b >= bearing_lo && b <= bearing_hi;
@@ -179,7 +194,8 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // 1. Foreground: near the expected position and away from the reference frame. Points farther from
   //    the reference position are background without a tree query (the paper's restriction), except
   //    in the sector between the LiDAR and the vehicle, where they count as occluders.
-  std::vector<Eigen::Vector3d> foreground;  // map frame, z = height above the road
+  std::vector<Eigen::Vector3d> foreground;  // map frame, z = height above the road under the point
+  std::vector<double> foreground_z;         // the map's z of each
   int far_occluders = 0;
   std::vector<int> index(1);
   std::vector<float> distance_sq(1);
@@ -187,14 +203,18 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   for (const Eigen::Vector3f& p : frame) {
     const Eigen::Vector3d in_map = impl_->rotation * p.cast<double>() + impl_->mount.position;
     const Eigen::Vector2d xy = in_map.head<2>();
-    const double height = in_map.z();
-    if (height < 0.05) continue;  // the road itself
     const bool near = (xy - reference).norm() <= c.search_radius;
-    if (!near && !(c.attribute && inSector(xy, height))) continue;
+    if (!near && !(c.attribute && inSector(xy, in_map.z()))) continue;
+    const double height = in_map.z() - road.height(xy);
+    if (height < 0.05) continue;  // the road itself
     if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq)
       continue;
-    if (near) foreground.emplace_back(xy.x(), xy.y(), height);
-    else ++far_occluders;
+    if (near) {
+      foreground.emplace_back(xy.x(), xy.y(), height);
+      foreground_z.push_back(in_map.z());
+    } else {
+      ++far_occluders;
+    }
   }
   out.foreground_points = foreground.size();
   const auto groups = clusters(foreground, c.cluster_distance);
@@ -265,7 +285,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
       int n = far_occluders;
       for (const Object& o : objects)
         if (&o != except)
-          for (std::size_t i : o.points) n += inSector(foreground[i].head<2>(), foreground[i].z()) ? 1 : 0;
+          for (std::size_t i : o.points) n += inSector(foreground[i].head<2>(), foreground_z[i]) ? 1 : 0;
       return n;
     };
     if (candidates.empty()) return finish(occluding(nullptr) >= c.occlusion_points ? Refusal::kOccluded : Refusal::kNoVehicle);
@@ -291,6 +311,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // 6. The lowest part of the body, the L-shape fit, the plain centre or the true-size box.
   if (!c.attribute) box = fitBody(vehicle_points, foreground, c, lidar, length, width, heading_prior, xy, &fit);
   if (xy.size() < 3) return finish(Refusal::kNoVehicle);
+  out.fit_points = xy.size();
   out.corner_seen = box.corner_seen;
   out.face_shortfall = box.face_shortfall;
   if (c.attribute && c.align_true_size && box.face_shortfall > c.max_face_shortfall) return finish(Refusal::kCornerNotSeen);
@@ -300,6 +321,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     out.heading_disagreement = off;
     if (off > c.max_heading_disagreement) return finish(Refusal::kHeadingDisagrees);
   }
+  if (c.attribute && static_cast<int>(xy.size()) < c.min_fit_points) return finish(Refusal::kTooFewPoints);
   const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
   if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);
   out.found = true;

@@ -35,6 +35,7 @@ using RosDimensions = coloc_msgs::msg::VehicleDimensions;
 
 std::string fixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/fix"; }
 std::string addressedFixTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/addressed_fix"; }
+std::string roadsidePointsTopic(const std::string& rsu_id) { return "/rsu/" + rsu_id + "/points"; }
 
 Stamp systemNow() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();

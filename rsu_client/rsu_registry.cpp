@@ -29,7 +29,9 @@ namespace {
 
 RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) {
   const std::string where = "rsus[" + std::to_string(index) + "]";
-  r.allowKeys(node, where, {"id", "position", "height", "lidar_model", "coverage_radius", "identity", "calibrated_variance", "calibration"});
+  r.allowKeys(node, where,
+              {"id", "position", "height", "yaw_deg", "roll_deg", "pitch_deg", "lidar_model", "coverage_radius", "identity", "calibrated_variance",
+               "calibration"});
   RsuInfo rsu;
   bool has_position = false, has_model = false;
   std::optional<double> radius;
@@ -46,6 +48,12 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
     } else if (key == "height") {
       rsu.height = r.inRange(entry.second, full, 0.0, 30.0);
       if (rsu.height == 0.0) r.fail(entry.second, full, "must be above the road (> 0 m)");
+    } else if (key == "yaw_deg") {
+      rsu.yaw = r.inRange(entry.second, full, -360.0, 360.0) * M_PI / 180.0;
+    } else if (key == "roll_deg") {
+      rsu.roll = r.inRange(entry.second, full, -45.0, 45.0) * M_PI / 180.0;
+    } else if (key == "pitch_deg") {
+      rsu.pitch = r.inRange(entry.second, full, -45.0, 45.0) * M_PI / 180.0;
     } else if (key == "lidar_model") {
       const std::string name = r.text(entry.second, full);
       const LidarModel* model = findLidarModel(name);
@@ -146,7 +154,11 @@ std::string RsuRegistry::toYaml() const {
   for (const RsuInfo& r : rsus_) {
     out << "  - id: " << r.id << "\n"
         << "    position: [" << number(r.position.x()) << ", " << number(r.position.y()) << "]\n"
-        << "    height: " << number(r.height) << "\n"
+        << "    height: " << number(r.height) << "\n";
+    if (r.yaw != 0.0) out << "    yaw_deg: " << number(r.yaw * 180.0 / M_PI) << "\n";
+    if (r.roll != 0.0) out << "    roll_deg: " << number(r.roll * 180.0 / M_PI) << "\n";
+    if (r.pitch != 0.0) out << "    pitch_deg: " << number(r.pitch * 180.0 / M_PI) << "\n";
+    out
         << "    lidar_model: " << r.lidar.name << "\n"
         << "    coverage_radius: " << number(r.coverage_radius) << "\n"
         << "    identity: \"" << r.identity << "\"\n";

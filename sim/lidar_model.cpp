@@ -30,10 +30,23 @@ LidarSpec vlp32c() {
   return s;
 }
 
+LidarSpec os1_64() {
+  LidarSpec s;
+  s.name = "OS1-64";
+  // 64 beams spread evenly over 45 deg, 1024 columns a turn: the kind of LiDAR roadside datasets put on
+  // poles (its beams below the horizon are 0.7 deg apart where a VLP-32C's are 1.5-9.4 deg apart).
+  for (int i = 0; i < 64; ++i) s.vertical_deg.push_back(-22.5 + 45.0 * i / 63.0);
+  s.azimuth_offset_deg.assign(64, 0.0);
+  s.azimuth_step_deg = 360.0 / 1024.0;
+  s.max_range = 120.0;
+  return s;
+}
+
 LidarSpec lidarNamed(const std::string& name) {
   if (name == "VLP-16") return vlp16();
   if (name == "VLP-32C") return vlp32c();
-  throw Error("no LiDAR model '" + name + "' in the twin (VLP-16, VLP-32C)");
+  if (name == "OS1-64") return os1_64();
+  throw Error("no LiDAR model '" + name + "' in the twin (VLP-16, VLP-32C, OS1-64)");
 }
 
 LidarSpec withErrors(LidarSpec spec, const ErrorSources& errors) {

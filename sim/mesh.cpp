@@ -1,5 +1,6 @@
 #include "coloc/sim/mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace coloc::sim {
@@ -14,6 +15,23 @@ TriangleMesh groundRectangle(const Eigen::Vector2f& min, const Eigen::Vector2f& 
   TriangleMesh m;
   m.vertices = {{min.x(), min.y(), z}, {max.x(), min.y(), z}, {max.x(), max.y(), z}, {min.x(), max.y(), z}};
   m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+TriangleMesh heightField(const Eigen::Vector2f& min, const Eigen::Vector2f& max, float step, const std::function<float(float, float)>& z) {
+  TriangleMesh m;
+  const int nx = std::max(1, static_cast<int>(std::ceil((max.x() - min.x()) / step))), ny = std::max(1, static_cast<int>(std::ceil((max.y() - min.y()) / step)));
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      const float x = std::min(max.x(), min.x() + i * step), y = std::min(max.y(), min.y() + j * step);
+      m.vertices.emplace_back(x, y, z(x, y));
+    }
+  const auto at = [&](int i, int j) { return j * (nx + 1) + i; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      m.triangles.emplace_back(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      m.triangles.emplace_back(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
   return m;
 }
 

@@ -10,6 +10,7 @@ void addConfigCommand(CLI::App& app);
 void addAlignCommand(CLI::App& app);
 void addRsuListenCommand(CLI::App& app);
 void addRsuPublishCommand(CLI::App& app);
+void addRsuNodeCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addExperimentCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);

@@ -161,6 +161,9 @@ void addLocalizeCommand(CLI::App& app) {
                   (unsigned long long)t.received, (unsigned long long)t.undecodable, (unsigned long long)(t.sequence_gaps + t.rejected),
                   (unsigned long long)t.sequence_gaps, (unsigned long long)t.rejected, t.longest_gap, t.first_error.empty() ? "" : "  first: ",
                   t.first_error.c_str());
+    for (const auto& t : s.topics)
+      if (t.from_before_clock_jump)
+        std::printf("  %s: %llu sent before /clock went back and arriving after, dropped\n", t.topic.c_str(), (unsigned long long)t.from_before_clock_jump);
     for (const auto& [id, c] : s.report.fixes) std::printf("  %s\n", fixLine(id, s.report).c_str());
     std::printf("  localization: %s\n", localizationLine(s.report).c_str());
     for (const auto& line : s.report.first_rejections) std::printf("  rejected: %s\n", line.c_str());

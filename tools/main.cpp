@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   coloc::tools::addAlignCommand(app);
   coloc::tools::addRsuListenCommand(app);
   coloc::tools::addRsuPublishCommand(app);
+  coloc::tools::addRsuNodeCommand(app);
   coloc::tools::addSimulateCommand(app);
   coloc::tools::addExperimentCommand(app);
   coloc::tools::addLocalizeCommand(app);

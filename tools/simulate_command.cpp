@@ -32,6 +32,9 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_flag("--compare-ideal", options.ideal_comparison,
                "also image every RSU frame in the ideal twin (no error sources) and fix it: ideal_error_m in rsu_frames.csv, beside "
                "the real fixes in rsu_fix_error.svg");
+  cmd->add_flag("--rsu-frames", options.record_rsu_frames,
+                "also record what each RSU's own node takes in (coloc rsu-node): its LiDAR frames on /rsu/<id>/points and the "
+                "connected vehicles' CAMs on /v2x/cam");
   static bool ideal = false;
   cmd->add_flag("--ideal", ideal, "drive the ideal twin: the scenario without its error sources (errors: preset ideal)");
   cmd->callback([] {

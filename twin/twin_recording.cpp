@@ -15,6 +15,7 @@
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
+#include "coloc/io/v2x_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/ndt/tile_map.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
@@ -46,8 +47,8 @@ Stamp at(double t) { return kEpoch + fromSeconds(t); }
 
 // The sweep as its driver publishes it, into `m` (kept between sweeps: a fresh 640 KB message per sweep
 // cost a zero fill and its page faults every time).
-void toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp, io::PointCloud2& m) {
-  m.header = {stamp, "lidar"};
+void toPointCloud2(const std::vector<sim::LidarPoint>& points, Stamp stamp, io::PointCloud2& m, const std::string& frame_id = "lidar") {
+  m.header = {stamp, frame_id};
   m.height = 1;
   m.width = static_cast<std::uint32_t>(points.size());
   m.fields = {{"x", 0, io::PointField::kFloat32, 1}, {"y", 4, io::PointField::kFloat32, 1}, {"z", 8, io::PointField::kFloat32, 1},
@@ -114,6 +115,13 @@ class LogRecorder {
     messages_.push_back(std::move(m));
     decoded_.resize(messages_.size());
     decoded_.back() = {stamp, ScanPool::shared().make(sweep.size(), [&](ndt::PointCloud& cloud) { scanOf(sweep, cloud); })};
+  }
+  /// A roadside LiDAR's frame, in its sensor frame: written to the file only (coloc rsu-node reads it);
+  /// in memory it is a message without a decoded scan.
+  void writeRoadsideFrame(const std::string& topic, Stamp log_time, const std::vector<sim::LidarPoint>& sweep, Stamp stamp, const std::string& frame_id) {
+    io::PointCloud2 m;
+    toPointCloud2(sweep, stamp, m, frame_id);
+    write(topic, log_time, io::encodePointCloud2(m));
   }
   std::shared_ptr<const replay::RecordedLog> close() {
     if (bag_) bag_->close();
@@ -274,6 +282,7 @@ rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& r) {
   info.id = r.id;
   info.position = r.position + r.survey_error.head<2>();  // the vehicle knows the surveyed position
   info.height = r.height;
+  info.yaw = r.yaw + r.survey_error.z();  // as surveyed
   info.lidar = *model;
   info.coverage_radius = model->range;
   info.identity = "CN=" + r.id;
@@ -401,6 +410,11 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::addressedFixTopic(r.info.id), "nav_msgs/msg/Odometry"));
   if (options.perfect_rsus)
     for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::addressedFixTopic(perfectRsuId(r.info.id)), "nav_msgs/msg/Odometry"));
+  if (options.record_rsu_frames) {
+    for (const Rsu& r : rsus) bag.addTopic(topic(rsu_client::roadsidePointsTopic(r.info.id), "sensor_msgs/msg/PointCloud2"));
+    bag.addTopic(topic(rsu_client::kCamTopic, io::kCamType));
+  }
+  std::mt19937_64 cam_rng(scenario.seed + 53);  // the recorded CAMs' errors: a stream of their own
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
@@ -473,6 +487,29 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     }
     bag.writeScan("/points", at(t + 0.1) + 5'000'000, sweep, at(t));  // the sweep ends, the driver publishes
     ++summary.scans;
+    // Each connected vehicle's CAM (10 Hz): where it thinks it is (0.3 m off), its front centre as
+    // ETSI's reference point, its size in the CAM's 0.1 m steps.
+    if (options.record_rsu_frames) {
+      const auto writeCam = [&](std::uint32_t station, const Eigen::Vector3d& pose, double speed, double yaw_rate, const sim::VehicleBody& b) {
+        std::normal_distribution<double> error(0.0, 0.3);
+        io::Cam c;
+        c.header = {at(t), "map"};
+        c.station_id = station;
+        c.heading = pose.z();
+        c.speed = speed;
+        c.yaw_rate = yaw_rate;
+        c.length = std::max(0.1, std::round(b.length * 10.0) / 10.0);
+        c.width = std::max(0.1, std::round(b.width * 10.0) / 10.0);
+        const Eigen::Vector2d centre = pose.head<2>() + Eigen::Vector2d(error(cam_rng), error(cam_rng));
+        c.reference = centre + 0.5 * c.length * Eigen::Vector2d(std::cos(c.heading), std::sin(c.heading));
+        bag.write(rsu_client::kCamTopic, at(t) + 1'000'000, io::encodeCam(c));
+      };
+      writeCam(scenario.vehicle_station_id, Eigen::Vector3d(truth.position.x(), truth.position.y(), truth.yaw), truth.speed, truth.yaw_rate, body);
+      for (std::size_t j : connected) {
+        const sim::TrafficVehicle& other = scenario.traffic[j];
+        if (const std::optional<Eigen::Vector3d> p = sim::trafficPose(route, other, t)) writeCam(*other.station_id, *p, other.speed, 0.0, other.body);
+      }
+    }
     // The RSUs see the vehicle where it is half-way through their sweep, and stamp the fix then.
     bool placed = false;
     const auto placeVehicle = [&] {
@@ -515,6 +552,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         summary.ray_casting_seconds += since(c1);  // the LiDAR model's share with it
         summary.rays += raysPerSweep(r.lidar);
       }
+      // The frame as the RSU's LiDAR driver publishes it: stamped at the sweep's start, in its own frame.
+      if (options.record_rsu_frames)
+        bag.writeRoadsideFrame(rsu_client::roadsidePointsTopic(r.info.id), at(t + 0.1) + 5'000'000, frame_room.points, at(t), r.info.id);
       // Every other connected vehicle in the same frame gets its own fix, found through its own CAM and
       // addressed to its station id, on the same topic: the ego's radio hears them all.
       for (std::size_t j = 0; j < connected.size(); ++j) {

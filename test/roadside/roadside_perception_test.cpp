@@ -182,8 +182,7 @@ TEST_F(Neighbours, ACarBumperToBumperMergesWithTheVehicleAndTheFrameIsRefusedAsT
 }
 
 // A LiDAR on a 6 m pole pitched 2 deg down towards the road, as poles' LiDARs are: the mount's tilt
-// levels its points. Left unlevelled, a point 30 m out is 1 m off in height and the height cut keeps
-// the wrong part of the car.
+// levels its points. Left unlevelled, a point 30 m out is 1 m off in height and 0.2 m off in position.
 TEST(RoadsidePerception, ATiltedLidarIsLevelledByItsMount) {
   RayCaster world;
   world.addMesh(groundRectangle({-20, -30}, {60, 30}));
@@ -220,7 +219,11 @@ TEST(RoadsidePerception, ATiltedLidarIsLevelledByItsMount) {
   // away from the CAM position: the high-mount fit is a question of its own), within 5 cm on average.
   ASSERT_GE(found_known, 3);
   EXPECT_LT(error_known / found_known, 0.15);
-  EXPECT_LT(found_ignored, found_known);
+  // Unlevelled, the local road found in the background absorbs the tilt in height (the cut still
+  // keeps the lower body), but not in position: a return 6 m below the LiDAR lies 6 sin(2 deg) = 0.21 m
+  // off horizontally.
+  ASSERT_GE(found_ignored, 1);
+  EXPECT_GT(error_ignored / found_ignored, 2.0 * error_known / found_known);
 }
 
 // An RSU beside a street, 28 m from a car in the ego lane, something on the line of sight between them;

@@ -43,6 +43,8 @@ struct TopicStatus {
   /// Samples its writers sent that never reached the node (gaps in each writer's sequence numbers),
   /// and DDS's own sample-lost and sample-rejected counts.
   std::uint64_t sequence_gaps = 0, lost = 0, rejected = 0;
+  /// Sent before /clock's last jump back and arriving after it: dropped (StampClock::reset).
+  std::uint64_t from_before_clock_jump = 0;
   Stamp last_arrival = 0;     ///< on the node's clock; 0: nothing yet
   double longest_gap = 0.0;   ///< s, the longest time between two arrivals
 };

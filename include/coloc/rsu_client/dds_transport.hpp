@@ -65,6 +65,12 @@ std::string fixTopic(const std::string& rsu_id);
 /// The ROS topic of this RSU's fixes addressed to one vehicle each (nav_msgs/msg/Odometry, the
 /// vehicle's station id in decimal as child_frame_id): see README, "The RSU fix protocol".
 std::string addressedFixTopic(const std::string& rsu_id);
+/// The RSU's own LiDAR frames (sensor_msgs/msg/PointCloud2, its sensor frame): what `coloc rsu-node`
+/// takes in, "/rsu/<id>/points". A vehicle's pipeline never takes them for its own scans.
+std::string roadsidePointsTopic(const std::string& rsu_id);
+/// Where connected vehicles' CAMs come (coloc_msgs/msg/Cam, io/v2x_messages.hpp), as a V2X bridge
+/// publishes them: "/v2x/cam".
+inline constexpr const char* kCamTopic = "/v2x/cam";
 inline constexpr const char* kVehicleDimensionsTopic = "/vehicle/dimensions";
 
 struct VehicleDimensions {

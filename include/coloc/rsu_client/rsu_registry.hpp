@@ -42,6 +42,10 @@ struct RsuInfo {
   std::string id;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< map frame, m
   double height = 2.0;                                  ///< m, LiDAR above the road
+  /// The LiDAR's mounting (yaw_deg, roll_deg, pitch_deg in the file): its x axis's heading in the map,
+  /// and its tilt (roll about its x axis, then pitch about its y axis, before the yaw). What the RSU's
+  /// own node needs to put its frames in the map; a vehicle does not use them.
+  double yaw = 0.0, roll = 0.0, pitch = 0.0;  ///< rad
   LidarModel lidar;
   double coverage_radius = 0.0;  ///< m; fixes farther than this from the RSU are refused
   std::string identity;          ///< subject of its DDS Security certificate, e.g. "CN=rsu_a"

@@ -1,7 +1,7 @@
 #pragma once
-// Velodyne LiDARs as the twist simulates them: real vertical angle tables, 10 Hz rotation with 0.2 deg
-// azimuth steps, each point stamped with its time in the sweep, Gaussian range noise growing with range,
-// lost returns, range limits.
+// LiDARs as the twin simulates them: Velodyne's real vertical angle tables (and an even 64-beam one for
+// poles), 10 Hz rotation with 0.2 deg azimuth steps, each point stamped with its time in the sweep,
+// Gaussian range noise growing with range, lost returns, range limits.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
@@ -30,7 +30,10 @@ struct LidarSpec {
 /// Velodyne's published calibration (ros-drivers/velodyne VLP16db.yaml, VeloView-VLP-32C.yaml).
 LidarSpec vlp16();
 LidarSpec vlp32c();
-/// "VLP-16" or "VLP-32C"; throws coloc::Error for any other name.
+/// A 64-beam LiDAR with evenly spread beams (45 deg vertical, 1024 columns), as on roadside poles; an
+/// idealised table, not a vendor's calibration.
+LidarSpec os1_64();
+/// "VLP-16", "VLP-32C" or "OS1-64"; throws coloc::Error for any other name.
 LidarSpec lidarNamed(const std::string& name);
 /// The spec with the noise and dropouts of `errors` (the error-sources header), the ideal ones kept otherwise.
 struct ErrorSources;

@@ -3,6 +3,7 @@
 // street needs: ground, boxes (buildings, walls, parked cars, vehicle bodies), upright cylinders (poles,
 // tree trunks).
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 namespace coloc::sim {
@@ -17,6 +18,10 @@ struct TriangleMesh {
 
 /// A flat rectangle at height z spanning [min, max] in x and y.
 TriangleMesh groundRectangle(const Eigen::Vector2f& min, const Eigen::Vector2f& max, float z = 0.0f);
+
+/// Ground that is not flat (a crowned road, a grade, gutters): the height z(x, y) sampled every `step`
+/// metres over [min, max], two triangles per square.
+TriangleMesh heightField(const Eigen::Vector2f& min, const Eigen::Vector2f& max, float step, const std::function<float(float, float)>& z);
 
 /// A box with its base centred at `base` (x, y, z of the bottom face), size (length along the heading,
 /// width, height), rotated by `yaw` about z.

@@ -61,6 +61,10 @@ struct TwinRecordingOptions {
   /// frames count as refused (roadside::Refusal::kBeyondOracleLimit). What a perception that never sent a
   /// fix of the tails would give. m; 0: off.
   double oracle_fix_limit = 0.0;
+  /// Also record what an RSU's own node takes in (coloc rsu-node): each RSU's LiDAR frames on
+  /// /rsu/<id>/points, in its sensor frame, and every connected vehicle's CAM on /v2x/cam (10 Hz, the
+  /// vehicle's own 0.3 m error, its size in 0.1 m steps). Several MB per second of drive per RSU.
+  bool record_rsu_frames = false;
 };
 
 /// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.

@@ -1,0 +1,114 @@
+#include "coloc/roadside/rsu_station.hpp"
+
+#include <cmath>
+
+#include "coloc/core/error.hpp"
+
+namespace coloc::roadside {
+
+struct RsuStation::Impl {
+  RsuMount mount;
+  RsuStationConfig config;
+  BackgroundLearner learner;
+  std::optional<RoadsidePerception> perception;
+  int since_rebuild = 0;
+  std::map<std::uint32_t, ConnectedVehicle> vehicles;
+  std::map<std::uint32_t, FixConsistency> tracks;
+  StationCounters counters;
+
+  Impl(const RsuMount& m, const RsuStationConfig& c) : mount(m), config(c), learner(c.background) {}
+
+  void rebuild() {
+    const std::vector<Eigen::Vector3f> background = learner.background();
+    if (background.empty()) return;  // nothing returned often enough yet: keep learning
+    perception.emplace(background, mount, config.perception);
+    since_rebuild = 0;
+    ++counters.background_rebuilds;
+  }
+};
+
+RsuStation::RsuStation(const RsuMount& mount, RsuStationConfig config) {
+  if (!mount.position.allFinite() || !std::isfinite(mount.yaw) || !std::isfinite(mount.roll) || !std::isfinite(mount.pitch))
+    throw Error("RSU station: the mount's position and angles must be finite");
+  if (!(config.coverage > 0.0) || !(config.max_cam_age > 0.0)) throw Error("RSU station: coverage and max_cam_age must be > 0");
+  if (config.commissioning_frames < 1 || config.refresh_frames < 1) throw Error("RSU station: commissioning_frames and refresh_frames must be >= 1");
+  impl_ = std::make_unique<Impl>(mount, config);
+}
+
+RsuStation::~RsuStation() = default;
+RsuStation::RsuStation(RsuStation&&) noexcept = default;
+RsuStation& RsuStation::operator=(RsuStation&&) noexcept = default;
+
+bool RsuStation::commissioned() const { return impl_->perception.has_value(); }
+const StationCounters& RsuStation::counters() const { return impl_->counters; }
+const RsuMount& RsuStation::mount() const { return impl_->mount; }
+
+std::optional<GroundPlane> RsuStation::roadPlane() const {
+  if (!impl_->perception) return std::nullopt;
+  return impl_->perception->roadPlane();
+}
+
+void RsuStation::learn(const std::vector<Eigen::Vector3f>& points) {
+  impl_->learner.add(points);
+  ++impl_->counters.commissioning_frames;
+}
+
+bool RsuStation::commission() {
+  impl_->rebuild();
+  return commissioned();
+}
+
+bool RsuStation::addVehicle(const ConnectedVehicle& v) {
+  Impl& d = *impl_;
+  ++d.counters.cams;
+  const bool finite = v.centre.allFinite() && std::isfinite(v.heading) && std::isfinite(v.speed) && std::isfinite(v.yaw_rate) &&
+                      std::isfinite(v.length) && std::isfinite(v.width);
+  const auto known = d.vehicles.find(v.station_id);
+  if (!finite || !(v.length > 0.0) || !(v.width > 0.0) || (known != d.vehicles.end() && v.stamp < known->second.stamp)) {
+    ++d.counters.cams_refused;
+    return false;
+  }
+  d.vehicles[v.station_id] = v;
+  return true;
+}
+
+std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>& points, Stamp stamp) {
+  Impl& d = *impl_;
+  ++d.counters.frames;
+  d.learner.add(points);
+  if (!d.perception) {
+    ++d.counters.commissioning_frames;
+    if (static_cast<int>(d.counters.commissioning_frames) >= d.config.commissioning_frames) d.rebuild();
+    return {};
+  }
+  if (++d.since_rebuild >= d.config.refresh_frames) d.rebuild();
+  std::vector<StationOutcome> out;
+  const Eigen::Vector2d lidar = d.mount.position.head<2>();
+  for (auto& [id, v] : d.vehicles) {
+    const double age = toSeconds(stamp - v.stamp);
+    if (std::abs(age) > d.config.max_cam_age) continue;
+    // Where the CAM's vehicle is at the frame's capture time: carried by its speed and yaw rate.
+    const double heading = v.heading + v.yaw_rate * age;
+    const double mid = v.heading + 0.5 * v.yaw_rate * age;
+    const Eigen::Vector2d centre = v.centre + v.speed * age * Eigen::Vector2d(std::cos(mid), std::sin(mid));
+    const double distance = (centre - lidar).norm();
+    if (distance > d.config.coverage) continue;
+    StationOutcome o;
+    o.station_id = id;
+    o.distance = distance;
+    o.detection = d.perception->detect(points, stamp, centre, heading, v.length, v.width);
+    FixConsistency& track = d.tracks.try_emplace(id).first->second;
+    if (!o.detection.found) {
+      track.miss();
+    } else if (!track.agrees(stamp, o.detection.position, v.speed * Eigen::Vector2d(std::cos(heading), std::sin(heading)))) {
+      o.detection.found = false;
+      o.detection.refusal = Refusal::kInconsistent;
+    }
+    if (o.detection.found) ++d.counters.fixes;
+    else ++d.counters.refused[static_cast<std::size_t>(o.detection.refusal)];
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+}  // namespace coloc::roadside

@@ -1,0 +1,123 @@
+// An RSU station over time: commissioned on the frames of a busy street, then a fix for each connected
+// vehicle its CAMs point to, each on its own track.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "coloc/core/error.hpp"
+#include "coloc/roadside/rsu_station.hpp"
+#include "coloc/sim/lidar_model.hpp"
+#include "coloc/sim/mesh.hpp"
+#include "coloc/sim/ray_caster.hpp"
+#include "coloc/sim/vehicle_body.hpp"
+
+namespace coloc::roadside {
+namespace {
+
+using namespace coloc::sim;  // the twin makes the frames
+
+// Two connected cars and an unconnected one on a street, an RSU's 64-beam LiDAR 8 m up on a pole,
+// pitched 1.9 deg down.
+class Station : public ::testing::Test {
+ protected:
+  Station() {
+    world_.addMesh(groundRectangle({-90, -40}, {90, 40}));
+    world_.addMesh(box({0, 16, 0}, {180, 1, 9}));
+    for (int i = 0; i < 3; ++i) cars_.push_back(world_.addMesh(car_.mesh(1e4 + 10 * i, 1e4, 0)));
+    world_.commit();
+    mount_.position = {0.0, -8.0, 8.0};
+    mount_.pitch = 1.9 * M_PI / 180.0;
+  }
+  std::vector<Eigen::Vector3f> frame() {
+    const Eigen::Isometry3d pose = Eigen::Translation3d(mount_.position) * Eigen::AngleAxisd(mount_.pitch, Eigen::Vector3d::UnitY());
+    std::vector<Eigen::Vector3f> f;
+    for (const LidarPoint& p : scanSweep(os1_64(), world_, [&](double) { return pose; }, rng_)) f.push_back(p.position);
+    return f;
+  }
+  // Car i at time t: x along the road at `speed` from `start`, in lane y.
+  struct Car {
+    double start, speed, y, yaw;
+  };
+  Eigen::Vector2d at(const Car& c, double t) const { return {c.start + c.speed * t * std::cos(c.yaw), c.y}; }
+  void place(const std::vector<Car>& cars, double t) {
+    for (std::size_t i = 0; i < cars.size(); ++i) world_.updateMesh(cars_[i], car_.mesh(at(cars[i], t).x(), cars[i].y, cars[i].yaw));
+    world_.commit();
+  }
+  // Its CAM, generated at `t` on the cars' clock, stamped `t + clock` on the station's.
+  ConnectedVehicle cam(std::uint32_t id, const Car& c, double t, double clock = 0.0) const {
+    ConnectedVehicle v;
+    v.stamp = fromSeconds(t + clock);
+    v.station_id = id;
+    v.centre = at(c, t) + Eigen::Vector2d(0.2, -0.25);  // the vehicle's own error, about 0.3 m
+    v.heading = c.yaw;
+    v.speed = c.speed;
+    v.length = std::round(car_.length * 10.0) / 10.0;  // a CAM's 0.1 m steps
+    v.width = std::round(car_.width * 10.0) / 10.0;
+    return v;
+  }
+  RayCaster world_;
+  VehicleBody car_;
+  std::vector<int> cars_;
+  RsuMount mount_;
+  RandomEngine rng_{8};
+};
+
+TEST_F(Station, CommissionedOnABusyStreetItFixesEachConnectedVehicleOnItsOwnTrack) {
+  RsuStationConfig config;
+  config.commissioning_frames = 40;
+  RsuStation station(mount_, config);
+  // Commissioning: 40 frames of traffic, never an empty street.
+  const std::vector<Car> traffic = {{-70, 10, 0, 0}, {70, 9, 3.5, M_PI}, {-40, 12, 0, 0}};
+  for (int k = 0; k < 40; ++k) {
+    place(traffic, 0.1 * k);
+    EXPECT_TRUE(station.frame(frame(), fromSeconds(0.1 * k)).empty());
+  }
+  ASSERT_TRUE(station.commissioned());
+  ASSERT_TRUE(station.roadPlane());
+  // Then two connected cars, one each way, and an unconnected one behind the first.
+  const std::vector<Car> cars = {{-55, 9, 0, 0}, {50, 9, 3.5, M_PI}, {-62, 9, 0, 0}};
+  std::map<std::uint32_t, int> fixes;
+  std::map<std::uint32_t, double> worst;
+  int looked_for = 0;
+  for (int k = 0; k < 60; ++k) {
+    const double t = 10.0 + 0.1 * k;
+    place(cars, t - 10.0);
+    station.addVehicle(cam(1001, cars[0], t - 10.0 - 0.05, 10.0));  // 50 ms before the frame
+    station.addVehicle(cam(1002, cars[1], t - 10.0 - 0.05, 10.0));
+    for (const StationOutcome& o : station.frame(frame(), fromSeconds(t))) {
+      ++looked_for;
+      if (!o.detection.found) continue;
+      const Car& c = o.station_id == 1001 ? cars[0] : cars[1];
+      ++fixes[o.station_id];
+      worst[o.station_id] = std::max(worst[o.station_id], (o.detection.position - at(c, t - 10.0)).norm());
+    }
+  }
+  std::printf("%d looks: station 1001 %d fixes (worst %.3f m), station 1002 %d fixes (worst %.3f m)\n", looked_for, fixes[1001], worst[1001],
+              fixes[1002], worst[1002]);
+  EXPECT_GE(fixes[1001], 20);
+  EXPECT_GE(fixes[1002], 20);
+  EXPECT_LT(worst[1001], 0.3);
+  EXPECT_LT(worst[1002], 0.3);
+  EXPECT_EQ(station.counters().fixes, static_cast<std::uint64_t>(fixes[1001] + fixes[1002]));
+}
+
+TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {
+  RsuStationConfig config;
+  config.commissioning_frames = 2;
+  RsuStation station(mount_, config);
+  station.frame(frame(), 0);
+  station.frame(frame(), fromSeconds(0.1));
+  const Car c{20, 8, 0, 0};
+  ConnectedVehicle old = cam(7, c, 0.0);
+  EXPECT_TRUE(station.addVehicle(old));
+  EXPECT_TRUE(station.frame(frame(), fromSeconds(1.5)).empty()) << "1.5 s after its CAM";
+  ConnectedVehicle nan = cam(8, c, 1.5);
+  nan.speed = std::nan("");
+  EXPECT_FALSE(station.addVehicle(nan));
+  ConnectedVehicle earlier = cam(7, c, -1.0);
+  EXPECT_FALSE(station.addVehicle(earlier)) << "older than the vehicle's last CAM";
+  EXPECT_EQ(station.counters().cams_refused, 2u);
+}
+
+}  // namespace
+}  // namespace coloc::roadside
