@@ -155,6 +155,14 @@ AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen:
     const double expected = std::abs(side.normalized().dot(heading)) >= std::sqrt(0.5) ? length : width;
     box.face_shortfall = std::max(0.0, expected - side.norm());
   }
+  {
+    const Eigen::Vector2d next = fit.corners[(nearest + 1) % 4] - a, previous = fit.corners[(nearest + 3) % 4] - a;
+    const bool next_is_length = std::abs(next.dot(along)) >= std::abs(next.dot(across));
+    box.length_face_points = next_is_length ? support[nearest] : support[(nearest + 3) % 4];
+    box.width_face_points = next_is_length ? support[(nearest + 3) % 4] : support[nearest];
+    box.length_face_extent = next_is_length ? next.norm() : previous.norm();
+    box.width_face_extent = next_is_length ? previous.norm() : next.norm();
+  }
   box.center = a + 0.5 * length * along + 0.5 * width * across;
   const Eigen::Vector2d forward = along.dot(heading) >= 0.0 ? along : -along;
   box.yaw = std::atan2(forward.y(), forward.x());

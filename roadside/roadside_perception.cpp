@@ -329,6 +329,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.alignment_point = box.alignment_point;
   out.position = position;
   out.yaw = box.yaw;
+  out.covariance = fixCovariance(box, (box.alignment_point - lidar).norm(), c.covariance);
   return finish(Refusal::kNone);
 }
 

@@ -159,16 +159,22 @@ FixVerdict FixChecker::checkSent(const RsuFix& fix, const RsuInfo& rsu, FixCount
     if (!std::isfinite(m(i, i)) || m(i, i) <= 0.0)
       return reject(FixRejection::kBadCovariance, entry(i, i) + (std::isfinite(m(i, i)) ? " is 0" : " is +inf (not measured)") + ": a fix must measure x and y",
                     c.bad_covariance);
-  // The variance the RSU sent against the registry's: an RSU that disagrees is misconfigured (another
-  // LiDAR model, another placement) and its fixes are not trusted blindly. A calibrated variance is
-  // the vehicle's own measurement of this RSU and supersedes what it sends, by the registry's word.
+  // The x/y block a covariance: its correlation within [-1, 1].
+  if (m(0, 1) * m(0, 1) > m(0, 0) * m(1, 1) * (1.0 + 1e-9))
+    return reject(FixRejection::kBadCovariance, "covariance[x,y] " + std::to_string(m(0, 1)) + " exceeds what the x and y variances allow", c.bad_covariance);
+  // The variance the RSU sent against the registry's: an RSU may say a fix is less sure than its
+  // LiDAR's figure (each fix's covariance from its own fit: a far car seen on one face), never surer;
+  // one that claims more is misconfigured (another LiDAR model, another placement) and its fixes are
+  // not trusted blindly. A calibrated variance is the vehicle's own measurement of this RSU and
+  // supersedes what it sends, by the registry's word.
   if (!rsu.calibrated_variance) {
     const double expected = registry_.variance(rsu);
     for (int i = 0; i < 2; ++i)
-      if (std::abs(m(i, i) - expected) > 1e-6 * expected) {
+      if (m(i, i) < expected * (1.0 - 1e-6)) {
         std::ostringstream why;
-        why << entry(i, i) << " " << m(i, i) << " disagrees with the registry's " << expected << " for its " << rsu.lidar.name << " ("
-            << (registry_.placement() == CovariancePlacement::kPublished ? "published" : "standard_deviation") << " placement)";
+        why << entry(i, i) << " " << m(i, i) << " is below the registry's " << expected << " for its " << rsu.lidar.name << " ("
+            << (registry_.placement() == CovariancePlacement::kPublished ? "published" : "standard_deviation")
+            << " placement): an RSU may send a fix as less sure than its LiDAR's figure, never as surer";
         return reject(FixRejection::kBadCovariance, why.str(), c.bad_covariance);
       }
   }
@@ -202,6 +208,9 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
   v.measurement.pose.position = {fix.x, fix.y, 0.0};
   v.measurement.covariance = Matrix6d::Zero();
   v.measurement.covariance.diagonal() << variance, variance, kInfinity, kInfinity, kInfinity, kInfinity;
+  // What the RSU sent of this fix (checked: at least the registry's figure), unless the vehicle's own
+  // calibration of this RSU supersedes it.
+  if (fix.sent && !rsu->calibrated_variance) v.measurement.covariance.topLeftCorner<2, 2>() = fix.sent->covariance.topLeftCorner<2, 2>();
   return v;
 }
 

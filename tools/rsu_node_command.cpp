@@ -4,6 +4,7 @@
 // (`coloc simulate --rsu-frames` records them), writing the fixes it would have sent.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -86,6 +87,17 @@ void printCounters(const roadside::RsuStation& station) {
   }
 }
 
+// A fix as sent: addressed to its vehicle, with the covariance of its own fit, never below the
+// registry's figure for this RSU's LiDAR (what a vehicle refuses): raised evenly where it would be.
+io::Bytes fixMessage(Stamp stamp, const roadside::StationOutcome& o, double floor) {
+  io::Odometry m = twin::addressedFix(stamp, o.detection.position, floor, o.station_id);
+  Eigen::Matrix2d c = o.detection.covariance;
+  const double lowest = std::min(c(0, 0), c(1, 1));
+  if (!(lowest >= floor)) c.diagonal().array() += floor - (std::isfinite(lowest) ? lowest : 0.0);
+  if (c.allFinite()) m.pose.covariance.topLeftCorner<2, 2>() = 0.5 * (c + c.transpose());
+  return io::encodeOdometry(m);
+}
+
 // The frame's points, in its sensor frame.
 std::vector<Eigen::Vector3f> pointsOf(const io::Bytes& bytes, Stamp& stamp) {
   const io::PointCloud2 cloud = io::decodePointCloud2(bytes.data(), bytes.size());
@@ -129,7 +141,7 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
   }
   std::filesystem::create_directories(s.out_dir);
   std::ofstream csv(s.out_dir + "/fixes.csv");
-  csv << "stamp_s,station_id,outcome,x,y,yaw_deg,distance_m,fit_points,processing_ms,error_m\n";
+  csv << "stamp_s,station_id,outcome,x,y,yaw_deg,distance_m,fit_points,processing_ms,error_m,sd_x_m,sd_y_m\n";
   io::BagWriter out = io::BagWriter::create(s.out_dir + "/log");
   io::TopicInfo fix_info;
   fix_info.name = fix_topic;
@@ -161,10 +173,11 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
             }
           }
           csv << formatSeconds(seen) << "," << o.station_id << "," << (d.found ? "fix" : roadside::toString(d.refusal)) << "," << d.position.x() << ","
-              << d.position.y() << "," << d.yaw * 180.0 / M_PI << "," << o.distance << "," << d.fit_points << "," << d.processing_ms << "," << error << "\n";
+              << d.position.y() << "," << d.yaw * 180.0 / M_PI << "," << o.distance << "," << d.fit_points << "," << d.processing_ms << "," << error << ","
+              << std::sqrt(d.covariance(0, 0)) << "," << std::sqrt(d.covariance(1, 1)) << "\n";
           if (!d.found) continue;
           // Sent once the frame is processed: the log's time of the frame plus the measured processing.
-          const io::Bytes fix = io::encodeOdometry(twin::addressedFix(seen, d.position, variance, o.station_id));
+          const io::Bytes fix = fixMessage(seen, o, variance);
           out.write(fix_topic, m.log_time + fromSeconds(d.processing_ms * 1e-3), fix.data(), fix.size());
         }
       }
@@ -233,7 +246,7 @@ void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, con
         outcomes = station.frame(points, seen);
       }
       for (const roadside::StationOutcome& o : outcomes)
-        if (o.detection.found && writer.write(io::encodeOdometry(twin::addressedFix(seen, o.detection.position, variance, o.station_id)))) ++sent;
+        if (o.detection.found && writer.write(fixMessage(seen, o, variance))) ++sent;
     } catch (const Error&) {
       ++undecodable;
     }

@@ -159,8 +159,10 @@ TEST(FixChecker, AMessagesFrameCovarianceAndStampFieldAreHeldAgainstTheRegistry)
       {"asymmetric", [](SentFields& s) { s.covariance(0, 1) = 0.001; }, FixRejection::kBadCovariance, "not symmetric"},
       {"x not measured", [](SentFields& s) { s.covariance(0, 0) = kInfinity; }, FixRejection::kBadCovariance, "+inf (not measured)"},
       {"y zero", [](SentFields& s) { s.covariance(1, 1) = 0.0; }, FixRejection::kBadCovariance, "covariance[y,y] is 0"},
-      {"another variance", [](SentFields& s) { s.covariance(0, 0) = s.covariance(1, 1) = 0.00681; }, FixRejection::kBadCovariance,
-       "disagrees with the registry's 0.01486"},
+      {"surer than the registry", [](SentFields& s) { s.covariance(0, 0) = s.covariance(1, 1) = 0.00681; }, FixRejection::kBadCovariance,
+       "is below the registry's 0.01486"},
+      {"x/y correlation beyond 1", [](SentFields& s) { s.covariance(0, 1) = s.covariance(1, 0) = 0.02; }, FixRejection::kBadCovariance,
+       "exceeds what the x and y variances allow"},
   };
   for (std::size_t k = 0; k < cases.size(); ++k) {
     RsuFix fix = sentFix(kNow - 2000 - static_cast<Stamp>(k), 101);
@@ -173,9 +175,27 @@ TEST(FixChecker, AMessagesFrameCovarianceAndStampFieldAreHeldAgainstTheRegistry)
   const FixCounters& a = c.counters().at("rsu_a");
   EXPECT_EQ(a.wrong_frame, 4u);
   EXPECT_EQ(a.bad_stamp, 1u);
-  EXPECT_EQ(a.bad_covariance, 8u);
+  EXPECT_EQ(a.bad_covariance, 9u);
   EXPECT_EQ(a.passed_checks, 1u);
   EXPECT_EQ(a.received, 1u + cases.size());
+}
+
+// Each fix's covariance from its own fit (roadside/fix_covariance.hpp): a fix sent as less sure than the
+// registry's figure for its LiDAR is taken with what it says, correlation included.
+TEST(FixChecker, AFixSentAsLessSureThanItsLidarsFigureIsTakenWithItsOwnCovariance) {
+  FixCheckConfig one_vehicle;
+  one_vehicle.accept_unaddressed = true;
+  FixChecker c(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n", "test"), one_vehicle);
+  RsuFix fix = sentFix(kNow - 1000, 101);
+  fix.sent->covariance(0, 0) = 0.04;
+  fix.sent->covariance(1, 1) = 0.02;
+  fix.sent->covariance(0, 1) = fix.sent->covariance(1, 0) = 0.01;
+  const FixVerdict v = c.check(fix, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_EQ(v.measurement.covariance(0, 0), 0.04);
+  EXPECT_EQ(v.measurement.covariance(1, 1), 0.02);
+  EXPECT_EQ(v.measurement.covariance(0, 1), 0.01);
+  EXPECT_TRUE(std::isinf(v.measurement.covariance(2, 2)));
 }
 
 TEST(FixChecker, ARegistryFrameOtherThanMapAndACalibratedVarianceAreHonoured) {

@@ -42,6 +42,11 @@ struct AlignedBox {
   /// (length or width, by the heading prior), m. A face seen whole ends at the vehicle's corners and the
   /// box still rests on a true one; a partial face's end is anywhere along the body.
   double face_shortfall = 0.0;
+  /// Returns along the two faces meeting at the alignment point (away from its ends): the face along
+  /// the length (which places the box across it) and the one along the width (which places it along),
+  /// with each face's fitted extent, m. What the fix's covariance is made of (fix_covariance.hpp).
+  int length_face_points = 0, width_face_points = 0;
+  double length_face_extent = 0.0, width_face_extent = 0.0;
 };
 
 /// Places a box of `length` x `width` on the alignment point and extends it along the rectangle's edges

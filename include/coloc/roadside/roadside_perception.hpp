@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "coloc/core/time.hpp"
+#include "coloc/roadside/fix_covariance.hpp"
 #include "coloc/roadside/lshape_fit.hpp"
 #include "coloc/roadside/road_surface.hpp"
 
@@ -59,6 +60,7 @@ struct RoadsidePerceptionConfig {
   bool local_road = true;
   RoadSurfaceConfig road;
   LShapeConfig lshape;
+  FixCovarianceModel covariance;
 };
 
 /// Where the RSU's LiDAR stands: map position of the sensor (z = height above the road), heading, and
@@ -99,6 +101,8 @@ struct VehicleDetection {
   bool corner_seen = true;         ///< AlignedBox::corner_seen of the fit
   double face_shortfall = 0.0;     ///< AlignedBox::face_shortfall of the fit, m
   double heading_disagreement = 0.0;  ///< rad, the fitted heading against the CAM's, modulo a half turn
+  /// The fix's covariance from its fit (fix_covariance.hpp), map frame, m^2; when found.
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   std::size_t foreground_points = 0, fit_points = 0;
   double processing_ms = 0.0;      ///< measured, the whole pipeline
 };
