@@ -198,12 +198,14 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
     for (std::size_t i = 0; i < root["rsus"].size(); ++i) {
       const YAML::Node n = root["rsus"][i];
       const std::string where = "rsus[" + std::to_string(i) + "]";
-      r.keys(n, where, {"id", "position", "height", "yaw", "lidar_model", "survey_error", "clock_offset_ms"});
+      r.keys(n, where, {"id", "position", "height", "yaw", "roll_deg", "pitch_deg", "lidar_model", "survey_error", "clock_offset_ms"});
       ScenarioRsu rsu;
       rsu.id = r.text(r.require(n, "id", where), where + ".id");
       rsu.position = r.vec2(r.require(n, "position", where), where + ".position");
       if (n["height"]) rsu.height = r.positive(n["height"], where + ".height");
       if (n["yaw"]) rsu.yaw = r.number(n["yaw"], where + ".yaw");
+      if (n["roll_deg"]) rsu.roll = r.inRange(n["roll_deg"], where + ".roll_deg", -45.0, 45.0) * M_PI / 180.0;
+      if (n["pitch_deg"]) rsu.pitch = r.inRange(n["pitch_deg"], where + ".pitch_deg", -45.0, 45.0) * M_PI / 180.0;
       if (n["survey_error"]) {
         const auto v = r.numbers(n["survey_error"], where + ".survey_error", 3, "[dx, dy, dyaw_deg]");
         const Eigen::Vector3d e(v[0], v[1], v[2]);
@@ -217,8 +219,8 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
         rsu.clock_offset_given = true;
       }
       if (n["lidar_model"]) rsu.lidar_model = r.text(n["lidar_model"], where + ".lidar_model");
-      if (rsu.lidar_model != "VLP-16" && rsu.lidar_model != "VLP-32C")
-        r.fail(n["lidar_model"], where + ".lidar_model", "unknown LiDAR model '" + rsu.lidar_model + "' (VLP-16, VLP-32C)");
+      if (rsu.lidar_model != "VLP-16" && rsu.lidar_model != "VLP-32C" && rsu.lidar_model != "OS1-64")
+        r.fail(n["lidar_model"], where + ".lidar_model", "unknown LiDAR model '" + rsu.lidar_model + "' (VLP-16, VLP-32C, OS1-64)");
       s.rsus.push_back(rsu);
     }
   }

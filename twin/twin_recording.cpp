@@ -230,6 +230,12 @@ io::TopicInfo topic(const std::string& name, const std::string& type) {
   return t;
 }
 
+// Where an RSU's LiDAR stands and how it is turned and tilted (RsuMount's convention).
+Eigen::Isometry3d rsuPose(const sim::ScenarioRsu& r) {
+  return Eigen::Translation3d(r.position.x(), r.position.y(), r.height) * Eigen::AngleAxisd(r.yaw, Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(r.pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(r.roll, Eigen::Vector3d::UnitX());
+}
+
 Eigen::Isometry3d vehiclePose(const sim::VehicleState& s, double height) {
   return Eigen::Translation3d(s.position.x(), s.position.y(), height) * Eigen::AngleAxisd(s.yaw, Eigen::Vector3d::UnitZ());
 }
@@ -277,12 +283,14 @@ void writeMap(const sim::Scenario& scenario, const std::string& dir) {
 
 rsu_client::RsuInfo registryEntry(const sim::ScenarioRsu& r) {
   const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
-  if (!model) throw Error("RSU " + r.id + ": no LiDAR model '" + r.lidar_model + "' (VLP-16, VLP-32C)");
+  if (!model) throw Error("RSU " + r.id + ": no LiDAR model '" + r.lidar_model + "' (VLP-16, VLP-32C, OS1-64)");
   rsu_client::RsuInfo info;
   info.id = r.id;
   info.position = r.position + r.survey_error.head<2>();  // the vehicle knows the surveyed position
   info.height = r.height;
   info.yaw = r.yaw + r.survey_error.z();  // as surveyed
+  info.roll = r.roll;
+  info.pitch = r.pitch;
   info.lidar = *model;
   info.coverage_radius = model->range;
   info.identity = "CN=" + r.id;
@@ -374,7 +382,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     roadside::RsuMount mount;
     mount.position = {r.position.x(), r.position.y(), r.height};
     mount.yaw = r.yaw;
-    const Eigen::Isometry3d pose = Eigen::Translation3d(mount.position) * Eigen::AngleAxisd(r.yaw, Eigen::Vector3d::UnitZ());
+    mount.roll = r.roll;
+    mount.pitch = r.pitch;
+    const Eigen::Isometry3d pose = rsuPose(r);
     const sim::LidarSpec lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), errors);
     const std::vector<Eigen::Vector3f> reference = frameOf(lidar, surveyed, pose, rng);
     const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
@@ -523,8 +533,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     for (Rsu& r : rsus) {
       const double distance = (seen.position - r.info.position).norm();
       if (distance > r.range) continue;
-      const Eigen::Isometry3d pose = Eigen::Translation3d(r.info.position.x(), r.info.position.y(), r.info.height) *
-                                     Eigen::AngleAxisd(r.info.yaw, Eigen::Vector3d::UnitZ());
+      const Eigen::Isometry3d pose = rsuPose(r.info);
       if (options.rsu_frames) {
         // Keyed by RSU and sweep; the fingerprint adds where the vehicle is, which the world holds.
         const sim::SensorTrajectory still = [&](double) { return pose; };

@@ -20,7 +20,8 @@ struct LidarModel {
   double range;  ///< m, effective range for vehicle detection
 };
 
-/// The models coloc knows: VLP-16 (0.01486, 30 m) and VLP-32C (0.00681, 50 m).
+/// The models coloc knows: VLP-16 (0.01486, 30 m) and VLP-32C (0.00681, 50 m), the paper's; OS1-64
+/// (0.00681, 60 m), a pole's 64-beam LiDAR without a published figure.
 const std::vector<LidarModel>& lidarModels();
 const LidarModel* findLidarModel(const std::string& name);
 

@@ -27,6 +27,9 @@ struct ScenarioRsu {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   double height = 2.0;
   double yaw = 0.0;
+  /// The LiDAR's tilt (roll_deg, pitch_deg in the file; rad here): about its x axis, then its y axis
+  /// (pitch > 0: its forward axis down towards the road), before the yaw. Poles' LiDARs are tilted.
+  double roll = 0.0, pitch = 0.0;
   std::string lidar_model = "VLP-16";
   /// The surveyed pose minus the true pose (dx, dy [m], dyaw [rad]): the RSU computes its fixes from
   /// its surveyed pose, so they are off by it; the vehicle's registry lists the surveyed position.
