@@ -218,6 +218,14 @@ void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, con
   fix_qos.depth = 10;
   rsu_client::DdsNode::Writer writer = node.advertise(rsu_client::addressedFixTopic(rsu.id), "nav_msgs/msg/Odometry", fix_qos);
   std::atomic<std::uint64_t> inputs{0}, undecodable{0}, sent{0};
+  std::mutex error_mutex;
+  std::string first_error;  // the first refused input, named with its reason
+  const auto refused = [&](const std::string& topic, const std::string& why) {
+    if (undecodable++ != 0) return;
+    std::lock_guard<std::mutex> lock(error_mutex);
+    first_error = topic + ": " + why;
+    std::fprintf(stderr, "rsu-node: %s (further ones counted)\n", first_error.c_str());
+  };
   rsu_client::TopicQos cam_qos;
   cam_qos.reliable = s.dds.reliable;
   cam_qos.depth = 100;  // a CAM from each vehicle in range, 10 Hz
@@ -227,8 +235,8 @@ void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, con
       const io::Cam cam = io::decodeCam(bytes.data(), bytes.size());
       std::lock_guard<std::mutex> lock(station_mutex);
       station.addVehicle(vehicleOf(cam));
-    } catch (const Error&) {
-      ++undecodable;
+    } catch (const Error& e) {
+      refused(rsu_client::kCamTopic, e.what());
     }
   });
   rsu_client::TopicQos points_qos;  // the LiDAR driver's sensor data: best effort unless asked
@@ -247,8 +255,8 @@ void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, con
       }
       for (const roadside::StationOutcome& o : outcomes)
         if (o.detection.found && writer.write(fixMessage(seen, o, variance))) ++sent;
-    } catch (const Error&) {
-      ++undecodable;
+    } catch (const Error& e) {
+      refused(rsu_client::roadsidePointsTopic(rsu.id), e.what());
     }
   });
   std::printf("rsu-node %s: frames %s, CAMs %s; fixes out on %s; LiDAR at [%.2f, %.2f] %.2f m up, yaw %.2f deg, roll %.2f, pitch %.2f; commissioning "
@@ -279,6 +287,7 @@ void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, con
   std::lock_guard<std::mutex> lock(station_mutex);
   std::printf("rsu-node %s stopped: %llu fixes sent\n", rsu.id.c_str(), (unsigned long long)sent.load());
   printCounters(station);
+  if (undecodable.load()) std::printf("  %llu inputs refused; the first: %s\n", (unsigned long long)undecodable.load(), first_error.c_str());
   std::fflush(stdout);
 }
 
