@@ -13,12 +13,15 @@
 #include <mutex>
 #include <thread>
 
+#include <Eigen/Eigenvalues>
+
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_reader.hpp"
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/io/v2x_messages.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
+#include "coloc/replay/svg_plot.hpp"
 #include "coloc/roadside/rsu_station.hpp"
 #include "coloc/rsu_client/dds_node.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
@@ -151,6 +154,11 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
   io::BagReader bag = io::BagReader::open(s.log);
   io::BagMessage m;
   std::vector<double> errors;
+  replay::PlotSeries error_series, sd_series;  // the scored station's fixes against range
+  error_series.label = "fix error";
+  error_series.points = true;
+  sd_series.label = "its own sd (larger axis)";
+  sd_series.points = true;
   std::uint64_t undecodable = 0;
   while (bag.next(m)) {
     try {
@@ -170,6 +178,10 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
               const double w = toSeconds(seen - before->first) / std::max(1e-9, toSeconds(after->first - before->first));
               error = (d.position - (before->second + w * (after->second - before->second))).norm();
               errors.push_back(error);
+              error_series.x.push_back(o.distance);
+              error_series.y.push_back(error);
+              sd_series.x.push_back(o.distance);
+              sd_series.y.push_back(std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(d.covariance).eigenvalues().maxCoeff()));
             }
           }
           csv << formatSeconds(seen) << "," << o.station_id << "," << (d.found ? "fix" : roadside::toString(d.refusal)) << "," << d.position.x() << ","
@@ -194,7 +206,17 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
     std::printf("  station %lld's fixes against /ground_truth/odom: %zu, median %.3f m, p90 %.3f m, worst %.3f m\n", (long long)s.truth_station,
                 errors.size(), errors[errors.size() / 2], errors[std::min(errors.size() - 1, errors.size() * 9 / 10)], errors.back());
   }
-  std::printf("  wrote %s/{fixes.csv, log/} (%s, nav_msgs/msg/Odometry addressed to each vehicle)\n", s.out_dir.c_str(), fix_topic.c_str());
+  if (!errors.empty()) {
+    replay::Plot plot;
+    plot.title = "RSU " + rsu.id + ": station " + std::to_string(s.truth_station) + "'s fixes against range";
+    plot.x_label = "distance from the RSU [m]";
+    plot.y_label = "[m]";
+    plot.y_from_zero = true;
+    plot.series = {error_series, sd_series};
+    replay::writeSvg(s.out_dir + "/fix_error.svg", plot);
+  }
+  std::printf("  wrote %s/{fixes.csv, log/%s} (%s, nav_msgs/msg/Odometry addressed to each vehicle)\n", s.out_dir.c_str(),
+              errors.empty() ? "" : ", fix_error.svg", fix_topic.c_str());
 }
 
 void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, const rsu_client::RsuInfo& rsu) {
