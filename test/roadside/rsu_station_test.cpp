@@ -101,6 +101,43 @@ TEST_F(Station, CommissionedOnABusyStreetItFixesEachConnectedVehicleOnItsOwnTrac
   EXPECT_EQ(station.counters().fixes, static_cast<std::uint64_t>(fixes[1001] + fixes[1002]));
 }
 
+// Two connected cars close behind each other (1 m apart), as in a queue coming towards the RSU: the
+// front car's CAM has the other car's body within its attribution radius, and it is found; the car
+// behind shows the pole only part of one face (its front hidden by the first car) and is refused rather
+// than sent wrong.
+TEST_F(Station, InAQueueTheFrontCarIsFoundAndTheHalfHiddenOneRefusedNotSentWrong) {
+  RsuStationConfig config;
+  config.commissioning_frames = 20;
+  RsuStation station(mount_, config);
+  const std::vector<Car> away = {{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}};
+  place(away, 0.0);
+  for (int k = 0; k < 20; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+  ASSERT_TRUE(station.commissioned());
+  const double gap = 1.0;
+  const std::vector<Car> queue = {{-30, 6, 0, 0}, {-30 - car_.length - gap, 6, 0, 0}, {-100, 0, 30, 0}};
+  std::map<std::uint32_t, int> fixes, refused;
+  std::map<std::uint32_t, double> worst;
+  for (int k = 0; k < 20; ++k) {
+    const double t = 0.1 * k;
+    place(queue, t);
+    station.addVehicle(cam(1001, queue[0], t, 2.0));
+    station.addVehicle(cam(1002, queue[1], t, 2.0));
+    for (const StationOutcome& o : station.frame(frame(), fromSeconds(t + 2.0))) {
+      if (!o.detection.found) {
+        ++refused[o.station_id];
+        continue;
+      }
+      ++fixes[o.station_id];
+      worst[o.station_id] = std::max(worst[o.station_id], (o.detection.position - at(queue[o.station_id == 1001 ? 0 : 1], t)).norm());
+    }
+  }
+  std::printf("queue 1 m apart: 1001 %d fixes (worst %.3f m), %d refused; 1002 %d fixes (worst %.3f m), %d refused\n", fixes[1001], worst[1001],
+              refused[1001], fixes[1002], worst[1002], refused[1002]);
+  EXPECT_GE(fixes[1001], 12);
+  EXPECT_LT(worst[1001], 0.3);
+  EXPECT_LT(worst[1002], 0.3) << "a fix of the half-hidden car was sent wrong";
+}
+
 TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {
   RsuStationConfig config;
   config.commissioning_frames = 2;
