@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Creates a DDS Security setup for coloc in OUT_DIR, as a road operator would: one CA that signs the
 # identities of the roadside units and the vehicle and the governance and permissions documents.
-# Permissions let each RSU publish only its own fix topics (addressed and unaddressed) and the vehicle publish only its dimensions.
+# Permissions let each RSU publish only its own fix topics (addressed and unaddressed) and read its LiDAR's frames and the
+# CAMs, the roadside sensors (LiDAR drivers, the V2X bridge) publish only those, and the vehicle publish only its dimensions.
 #
 #   scripts/make-dds-security.sh OUT_DIR [RSU_ID ...]      (default RSUs: rsu_a rsu_b)
 #
@@ -94,11 +95,17 @@ XML
 sign governance operator_ca
 
 fix_topics=""
+sensor_topics="rt/v2x/cam"
 for id in "${rsus[@]}"; do
   make_identity "$id" operator_ca
-  permissions "$id" "rt/rsu/$id/addressed_fix rt/rsu/$id/fix" "rt/vehicle/dimensions" operator_ca
+  # The RSU's node (coloc rsu-node) reads its own LiDAR's frames and the CAMs.
+  permissions "$id" "rt/rsu/$id/addressed_fix rt/rsu/$id/fix" "rt/vehicle/dimensions rt/rsu/$id/points rt/v2x/cam" operator_ca
   fix_topics="$fix_topics rt/rsu/$id/addressed_fix rt/rsu/$id/fix"
+  sensor_topics="$sensor_topics rt/rsu/$id/points"
 done
+# What feeds the RSU nodes at the roadside: the LiDARs' drivers and the V2X stack's bridge.
+make_identity roadside_sensors operator_ca
+permissions roadside_sensors "$sensor_topics" "" operator_ca
 make_identity vehicle operator_ca
 permissions vehicle "rt/vehicle/dimensions" "$fix_topics" operator_ca
 
@@ -119,4 +126,4 @@ mkdir -p rogue
 make_identity intruder_listed operator_ca
 permissions intruder_listed "" "$fix_topics" operator_ca
 rm -f ./*.srl
-echo "DDS Security files in $out: CA, ${rsus[*]}, vehicle, intruder_rogue, intruder_listed"
+echo "DDS Security files in $out: CA, ${rsus[*]}, roadside_sensors, vehicle, intruder_rogue, intruder_listed"
