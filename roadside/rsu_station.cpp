@@ -14,6 +14,7 @@ struct RsuStation::Impl {
   int since_rebuild = 0;
   std::map<std::uint32_t, ConnectedVehicle> vehicles;
   std::map<std::uint32_t, FixConsistency> tracks;
+  std::optional<Stamp> last_frame;
   StationCounters counters;
 
   Impl(const RsuMount& m, const RsuStationConfig& c) : mount(m), config(c), learner(c.background) {}
@@ -30,7 +31,8 @@ struct RsuStation::Impl {
 RsuStation::RsuStation(const RsuMount& mount, RsuStationConfig config) {
   if (!mount.position.allFinite() || !std::isfinite(mount.yaw) || !std::isfinite(mount.roll) || !std::isfinite(mount.pitch))
     throw Error("RSU station: the mount's position and angles must be finite");
-  if (!(config.coverage > 0.0) || !(config.max_cam_age > 0.0)) throw Error("RSU station: coverage and max_cam_age must be > 0");
+  if (!(config.coverage > 0.0) || !(config.max_cam_age > 0.0) || !(config.forget_after >= config.max_cam_age))
+    throw Error("RSU station: coverage and max_cam_age must be > 0, forget_after at least max_cam_age");
   if (config.commissioning_frames < 1 || config.refresh_frames < 1) throw Error("RSU station: commissioning_frames and refresh_frames must be >= 1");
   impl_ = std::make_unique<Impl>(mount, config);
 }
@@ -42,6 +44,7 @@ RsuStation& RsuStation::operator=(RsuStation&&) noexcept = default;
 bool RsuStation::commissioned() const { return impl_->perception.has_value(); }
 const StationCounters& RsuStation::counters() const { return impl_->counters; }
 const RsuMount& RsuStation::mount() const { return impl_->mount; }
+std::size_t RsuStation::vehiclesKnown() const { return impl_->vehicles.size(); }
 
 std::optional<GroundPlane> RsuStation::roadPlane() const {
   if (!impl_->perception) return std::nullopt;
@@ -63,7 +66,13 @@ bool RsuStation::addVehicle(const ConnectedVehicle& v) {
   ++d.counters.cams;
   const bool finite = v.centre.allFinite() && std::isfinite(v.heading) && std::isfinite(v.speed) && std::isfinite(v.yaw_rate) &&
                       std::isfinite(v.length) && std::isfinite(v.width);
-  const auto known = d.vehicles.find(v.station_id);
+  auto known = d.vehicles.find(v.station_id);
+  // Far older than the vehicle's last: its clock (or a replayed log's) went back; a new timeline.
+  if (finite && known != d.vehicles.end() && toSeconds(known->second.stamp - v.stamp) > d.config.forget_after) {
+    d.tracks.erase(known->first);
+    d.vehicles.erase(known);
+    known = d.vehicles.end();
+  }
   if (!finite || !(v.length > 0.0) || !(v.width > 0.0) || (known != d.vehicles.end() && v.stamp < known->second.stamp)) {
     ++d.counters.cams_refused;
     return false;
@@ -75,6 +84,14 @@ bool RsuStation::addVehicle(const ConnectedVehicle& v) {
 std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>& points, Stamp stamp) {
   Impl& d = *impl_;
   ++d.counters.frames;
+  // The frames' clock went back (a LiDAR driver restarted, a log played again): the CAMs and tracks
+  // belong to the other timeline. The background does not.
+  if (d.last_frame && stamp + kNanosPerSecond < *d.last_frame) {
+    d.vehicles.clear();
+    d.tracks.clear();
+    ++d.counters.clock_resets;
+  }
+  d.last_frame = stamp;
   d.learner.add(points);
   if (!d.perception) {
     ++d.counters.commissioning_frames;
@@ -82,6 +99,15 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
     return {};
   }
   if (++d.since_rebuild >= d.config.refresh_frames) d.rebuild();
+  // Vehicles long gone are forgotten with their tracks: a busy intersection sees thousands a day.
+  for (auto it = d.vehicles.begin(); it != d.vehicles.end();) {
+    if (toSeconds(stamp - it->second.stamp) > d.config.forget_after) {
+      d.tracks.erase(it->first);
+      it = d.vehicles.erase(it);
+    } else {
+      ++it;
+    }
+  }
   std::vector<StationOutcome> out;
   const Eigen::Vector2d lidar = d.mount.position.head<2>();
   for (auto& [id, v] : d.vehicles) {

@@ -82,6 +82,7 @@ void printCounters(const roadside::RsuStation& station) {
   std::printf("  %llu frames (%llu learned while commissioning), %llu CAMs (%llu refused), %llu fixes; refused: %s\n", (unsigned long long)c.frames,
               (unsigned long long)c.commissioning_frames, (unsigned long long)c.cams, (unsigned long long)c.cams_refused, (unsigned long long)c.fixes,
               refusalCounts(c).c_str());
+  if (c.clock_resets) std::printf("  the frames' clock went back %llu times: CAMs and tracks started afresh each time\n", (unsigned long long)c.clock_resets);
   if (const auto plane = station.roadPlane()) {
     const roadside::Levelling l = roadside::levellingOf(*plane);
     std::printf("  road found in the background: %zu cells, %.3f m rms about its plane; the plane slopes %.2f deg along x, %.2f deg along y "

@@ -138,6 +138,30 @@ TEST_F(Station, InAQueueTheFrontCarIsFoundAndTheHalfHiddenOneRefusedNotSentWrong
   EXPECT_LT(worst[1002], 0.3) << "a fix of the half-hidden car was sent wrong";
 }
 
+// A log played again into the node, or a driver restarted: the frames' and the CAMs' stamps go back.
+// The station starts its vehicles afresh and finds them on the second pass as on the first.
+TEST_F(Station, TimeGoingBackStartsTheVehiclesAfreshAndTheSecondPassIsFixedAsTheFirst) {
+  RsuStationConfig config;
+  config.commissioning_frames = 10;
+  RsuStation station(mount_, config);
+  const std::vector<Car> away = {{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}};
+  place(away, 0.0);
+  for (int k = 0; k < 10; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+  const std::vector<Car> cars = {{-40, 6, 0, 0}, {-100, 0, 30, 0}, {-110, 0, 30, 0}};
+  int fixes[2] = {0, 0};
+  for (int pass = 0; pass < 2; ++pass)
+    for (int k = 0; k < 15; ++k) {
+      const double t = 0.1 * k;
+      place(cars, t);
+      station.addVehicle(cam(1001, cars[0], t, 5.0));
+      for (const StationOutcome& o : station.frame(frame(), fromSeconds(t + 5.0))) fixes[pass] += o.detection.found ? 1 : 0;
+    }
+  std::printf("first pass %d fixes, second %d; %llu clock resets\n", fixes[0], fixes[1], (unsigned long long)station.counters().clock_resets);
+  EXPECT_GE(fixes[0], 10);
+  EXPECT_GE(fixes[1], fixes[0] - 1);
+  EXPECT_EQ(station.counters().clock_resets, 1u);
+}
+
 TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {
   RsuStationConfig config;
   config.commissioning_frames = 2;
@@ -154,6 +178,10 @@ TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {
   ConnectedVehicle earlier = cam(7, c, -1.0);
   EXPECT_FALSE(station.addVehicle(earlier)) << "older than the vehicle's last CAM";
   EXPECT_EQ(station.counters().cams_refused, 2u);
+  // Ten seconds on, a vehicle that sent nothing since is forgotten (hours of traffic take no memory).
+  EXPECT_EQ(station.vehiclesKnown(), 1u);
+  station.frame(frame(), fromSeconds(10.5));
+  EXPECT_EQ(station.vehiclesKnown(), 0u);
 }
 
 }  // namespace

@@ -31,6 +31,7 @@ struct ConnectedVehicle {
 struct RsuStationConfig {
   double coverage = 60.0;         ///< m from the LiDAR: vehicles farther are not looked for
   double max_cam_age = 1.0;       ///< s between a CAM and the frame it is used in (CAMs come at 1-10 Hz)
+  double forget_after = 10.0;     ///< s without a CAM after which a vehicle and its track are forgotten
   int commissioning_frames = 50;  ///< frames learned before the first fix
   int refresh_frames = 100;       ///< afterwards, the background is rebuilt from what was learned this often
   BackgroundConfig background = [] {
@@ -51,6 +52,7 @@ struct StationCounters {
   std::uint64_t frames = 0, commissioning_frames = 0, cams = 0, cams_refused = 0, fixes = 0;
   std::array<std::uint64_t, kRefusalCount> refused{};  ///< per Refusal
   std::uint64_t background_rebuilds = 0;
+  std::uint64_t clock_resets = 0;  ///< frames stamped more than 1 s before the last: CAMs and tracks forgotten
 };
 
 class RsuStation {
@@ -61,7 +63,7 @@ class RsuStation {
   RsuStation& operator=(RsuStation&&) noexcept;
 
   /// A CAM. One that is not finite, has no size, or is older than the vehicle's last is refused
-  /// (false, counted).
+  /// (false, counted); one older by more than forget_after starts the vehicle afresh (its clock went back).
   bool addVehicle(const ConnectedVehicle& vehicle);
   /// A frame (sensor frame) captured at `stamp`: learned into the background; once commissioned, each
   /// connected vehicle within coverage whose CAM is recent is looked for, and its outcome returned.
@@ -76,6 +78,8 @@ class RsuStation {
   bool commissioned() const;
   const StationCounters& counters() const;
   const RsuMount& mount() const;
+  /// Connected vehicles whose CAM is recent enough to be kept (RsuStationConfig::forget_after).
+  std::size_t vehiclesKnown() const;
   /// The road found in the background (its plane in the map frame), once commissioned.
   std::optional<GroundPlane> roadPlane() const;
 
