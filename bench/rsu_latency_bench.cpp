@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   const int kFixes = argc > 1 ? std::max(1, std::atoi(argv[1])) : 1000;
   pipeline::Config config;
   config.fusion.auto_initialize = false;
-  config.rsu.checks.station_id = 7;  // the vehicle's CAM station id: fixes are addressed to it (README, the RSU fix protocol)
+  config.rsu.checks.station_id = 7;  // the vehicle's CAM station id: fixes are addressed to it (docs/rsu-protocol.md)
   pipeline::PipelineOptions options;
   options.registry = rsu_client::RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [0, 0], lidar_model: VLP-32C}\n", "bench");
   pipeline::Pipeline vehicle(config, std::move(options));

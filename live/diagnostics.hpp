@@ -1,6 +1,6 @@
 #pragma once
 // The live node's /diagnostics, under the names Autoware's monitors read where coloc stands in for
-// ekf_localizer and ndt_scan_matcher (their status names and keys, README "Autoware"), and one status
+// ekf_localizer and ndt_scan_matcher (their status names and keys, docs/live.md, "coloc in an Autoware system"), and one status
 // of coloc's own for its inputs and what the transport lost.
 #include <cstdint>
 

@@ -11,7 +11,7 @@ void addConfigCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("config", "Print the default configuration, its reference table, or check a file");
   static bool markdown = false;
   static std::string check;
-  cmd->add_flag("--markdown", markdown, "print the README's reference table instead of YAML");
+  cmd->add_flag("--markdown", markdown, "print the reference table of docs/configuration.md instead of YAML");
   cmd->add_option("--check", check, "validate this YAML file and exit")->check(CLI::ExistingFile);
   cmd->callback([] {
     if (!check.empty()) {

@@ -20,7 +20,7 @@ void addExperimentCommand(CLI::App& app) {
   static std::string file, out_dir = "results/experiment";
   static int trials = 0, jobs = 0;
   static bool quick = false, sweeps = false, no_network = false, recordings = false;
-  cmd->add_option("FILE", file, "experiment YAML overriding the defaults (keys: see experiment_config.hpp or the README)")
+  cmd->add_option("FILE", file, "experiment YAML overriding the defaults (keys: see experiment_config.hpp or docs/experiment.md)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "results folder")->capture_default_str();
   cmd->add_option("--trials", trials, "trials per site (default 10)")->check(wholeNumber(1, 1000));

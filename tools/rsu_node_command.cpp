@@ -1,6 +1,6 @@
 // `coloc rsu-node`: a roadside unit's own process (the paper's RSU node). Its LiDAR's frames and the
-// connected vehicles' CAMs in; for each vehicle it finds, a fix addressed to it out (README, "The RSU
-// fix protocol"). Live over DDS with ROS 2 names and QoS, or offline over a log that holds the frames
+// connected vehicles' CAMs in; for each vehicle it finds, a fix addressed to it out (docs/rsu-protocol.md,
+// "The RSU fix protocol"). Live over DDS with ROS 2 names and QoS, or offline over a log that holds the frames
 // (`coloc simulate --rsu-frames` records them), writing the fixes it would have sent.
 #include <atomic>
 #include <chrono>

@@ -31,8 +31,8 @@ TEST(Config, ShippedDefaultFileIsExactlyTheGeneratedDefaults) {
 }
 
 TEST(Config, ReadmeCarriesTheGeneratedReferenceTable) {
-  EXPECT_NE(readFile(COLOC_SOURCE_DIR "/README.md").find(configReferenceMarkdown()), std::string::npos)
-      << "regenerate the README table: coloc config --markdown";
+  EXPECT_NE(readFile(COLOC_SOURCE_DIR "/docs/configuration.md").find(configReferenceMarkdown()), std::string::npos)
+      << "regenerate the table of docs/configuration.md: coloc config --markdown";
 }
 
 TEST(Config, DefaultYamlParsesBackToTheDefaults) {

@@ -1,7 +1,7 @@
 #pragma once
 // A table describing every EkfConfig field: its config key, unit and meaning. The defaults stay in
 // EkfConfig's initialisers (the one place); this table lets the YAML loader, `coloc config` and the
-// README's reference table all speak of the same keys without repeating them.
+// reference table in docs/configuration.md all speak of the same keys without repeating them.
 #include <string>
 #include <variant>
 #include <vector>

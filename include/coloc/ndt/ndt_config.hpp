@@ -60,7 +60,7 @@ struct NdtConfig {
   /// optimum's weighs 1/e of it. Autoware's 0.05 makes the ground of an open road, which scores alike
   /// a metre along, outweigh the structure that holds the scan (10-50 cm along the road where NDT is
   /// within 2 cm); 0.02 keeps the floor there and still sees the open stretch of the twin's site B,
-  /// where 0.01 no longer does (README, "The filter against its best input").
+  /// where 0.01 no longer does (docs/experiment.md, "The filter against its best input").
   double score_temperature = 0.02;
   /// multi_ndt_score: yaw probes at +-1 and +-2 times this (deg); 0 = x/y only, as Autoware. Equal
   /// weights over five probes give a variance of 2 x this squared, so they matter only under a yaw

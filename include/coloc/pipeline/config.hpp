@@ -23,7 +23,7 @@ namespace coloc::pipeline {
 enum class InputRole { kPose, kTwist, kGroundTruth, kScan, kRsuFix, kStaticTransforms, kIgnore };
 const char* toString(InputRole role);
 
-/// How one topic is used. Topics not listed are chosen by message type (see README).
+/// How one topic is used. Topics not listed are chosen by message type (see docs/fuse.md).
 struct InputConfig {
   InputRole role = InputRole::kIgnore;
   std::string source;                      ///< name in the Localizer; default: the topic
@@ -77,7 +77,7 @@ struct RsuSection {
   /// Ticks over which each fix is applied; 0: fusion.pose_smoothing_steps, as every other pose.
   /// Autoware spreads every pose over five ticks so that NDT's pose does not jump; a centimetre fix
   /// need not be, and applied whole its information is in the estimate four ticks sooner. On the twin
-  /// that changed nothing beyond the trials' spread (README, *Network*), so fixes stay as Autoware's poses.
+  /// that changed nothing beyond the trials' spread (docs/experiment.md, *Network*), so fixes stay as Autoware's poses.
   int smoothing_steps = 0;
 };
 
@@ -105,13 +105,13 @@ struct PipelineSection {
   /// Learn the odometry's yaw-rate bias (gyro) from NDT's heading changes and remove it before the
   /// filter. Off by default: it finds the twin's 0.002 rad/s within 0.0003, but with Autoware's loose
   /// yaw-rate covariance the filter gains nothing, and on site B's bend the corrected heading tipped
-  /// NDT into following its own initial guess (2 cm -> 44 cm; README, "The filter against its best input").
+  /// NDT into following its own initial guess (2 cm -> 44 cm; docs/experiment.md, "The filter against its best input").
   bool yaw_rate_bias_estimation = false;
   double yaw_rate_bias_memory = 60.0;  ///< s over which old comparisons fade
   /// Learn the LiDAR's mounting yaw (NDT's heading minus the direction of travel) from NDT's own poses
   /// and correct NDT's poses by it before the filter. Off by default: the filter's yaw-bias state
   /// learns the same angle within about 10 s, and correcting it earlier changed the error by -1 to +18 %
-  /// on the twin (README); the learned angle is reported either way.
+  /// on the twin (docs/experiment.md); the learned angle is reported either way.
   bool mount_yaw_estimation = false;
   double mount_yaw_memory = 500.0;  ///< m of travel over which old comparisons fade
 };
@@ -196,7 +196,7 @@ std::string defaultConfigYaml();
 /// inputs included, after `heading` (comment lines).
 std::string configYaml(const Config& config, const std::string& heading = "");
 
-/// The README's reference table (Markdown) of every key.
+/// The reference table (Markdown) of every key, as docs/configuration.md has it.
 std::string configReferenceMarkdown();
 
 }  // namespace coloc::pipeline

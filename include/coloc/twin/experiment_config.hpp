@@ -52,7 +52,7 @@ struct ExperimentConfig {
   /// `estimated_position`), NDT on site B's open stretch, started from the filter's prediction where
   /// the map holds it weakly, confirms that prediction and both drift off together (2 cm -> 0.1-5 m).
   /// `multi_ndt_score`, the default, trusts NDT as measured where its score holds it and not along a
-  /// direction where the score is flat (README, "The filter against its best input").
+  /// direction where the score is flat (docs/experiment.md, "The filter against its best input").
   NdtCovarianceSource ndt_covariance = NdtCovarianceSource::kMultiNdtScore;
   /// Estimated by default: with the fixes carried to their tick (fusion.pose_time_alignment) the
   /// filter can trust them as much as they deserve; Table I shows the paper's figures beside it.

@@ -70,7 +70,7 @@ struct TwinRecordingOptions {
 /// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.
 std::string perfectRsuId(const std::string& id);
 
-/// A roadside fix as an RSU sends it under the protocol (README, "The RSU fix protocol"): addressed to
+/// A roadside fix as an RSU sends it under the protocol (docs/rsu-protocol.md): addressed to
 /// the vehicle of `station_id`, the RSU's variance on x and y, not measured elsewhere.
 io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, double variance, std::uint32_t station_id);
 
