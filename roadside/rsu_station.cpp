@@ -15,6 +15,8 @@ struct RsuStation::Impl {
   std::map<std::uint32_t, ConnectedVehicle> vehicles;
   std::map<std::uint32_t, FixConsistency> tracks;
   std::optional<Stamp> last_frame;
+  bool levelled = false;
+  std::optional<Levelling> levelling;  ///< what the road showed of the LiDAR's tilt and height
   StationCounters counters;
 
   Impl(const RsuMount& m, const RsuStationConfig& c) : mount(m), config(c), learner(c.background) {}
@@ -22,6 +24,19 @@ struct RsuStation::Impl {
   void rebuild() {
     const std::vector<Eigen::Vector3f> background = learner.background();
     if (background.empty()) return;  // nothing returned often enough yet: keep learning
+    // The first time, the LiDAR's tilt from the road it sees, if asked (the registry's otherwise).
+    if (config.level_from_ground && !levelled) {
+      std::vector<Eigen::Vector3d> sensor;
+      sensor.reserve(background.size());
+      for (const Eigen::Vector3f& p : background) sensor.push_back(p.cast<double>());
+      if (const std::optional<GroundPlane> plane = fitGroundPlane(sensor, Eigen::Vector2d::Zero(), config.perception.road)) {
+        const Levelling l = levellingOf(*plane);
+        mount.roll = l.roll;
+        mount.pitch = l.pitch;
+        levelling = l;
+        levelled = true;
+      }
+    }
     perception.emplace(background, mount, config.perception);
     since_rebuild = 0;
     ++counters.background_rebuilds;
@@ -45,6 +60,7 @@ bool RsuStation::commissioned() const { return impl_->perception.has_value(); }
 const StationCounters& RsuStation::counters() const { return impl_->counters; }
 const RsuMount& RsuStation::mount() const { return impl_->mount; }
 std::size_t RsuStation::vehiclesKnown() const { return impl_->vehicles.size(); }
+std::optional<Levelling> RsuStation::levelling() const { return impl_->levelling; }
 
 std::optional<GroundPlane> RsuStation::roadPlane() const {
   if (!impl_->perception) return std::nullopt;

@@ -42,6 +42,7 @@ extern "C" void requestNodeStop(int) { g_stop_node.store(true); }
 struct NodeSettings {
   std::string registry_path = "config/rsu.yaml", id, log, out_dir = "rsu_node_out";
   int commission = 50;
+  bool level_from_ground = false;
   double frame_time_offset = 0.05;  // s from a frame's header stamp to the moment the vehicle is seen
   std::int64_t truth_station = -1;
   double duration = 0.0, idle = 0.0;
@@ -82,12 +83,18 @@ void printCounters(const roadside::RsuStation& station) {
   std::printf("  %llu frames (%llu learned while commissioning), %llu CAMs (%llu refused), %llu fixes; refused: %s\n", (unsigned long long)c.frames,
               (unsigned long long)c.commissioning_frames, (unsigned long long)c.cams, (unsigned long long)c.cams_refused, (unsigned long long)c.fixes,
               refusalCounts(c).c_str());
+  if (const auto l = station.levelling())
+    std::printf("  levelled from the road: roll %.2f deg, pitch %.2f deg, %.2f m above it (the registry's tilt replaced)\n", l->roll * 180.0 / M_PI,
+                l->pitch * 180.0 / M_PI, l->height);
   if (c.clock_resets) std::printf("  the frames' clock went back %llu times: CAMs and tracks started afresh each time\n", (unsigned long long)c.clock_resets);
   if (const auto plane = station.roadPlane()) {
     const roadside::Levelling l = roadside::levellingOf(*plane);
     std::printf("  road found in the background: %zu cells, %.3f m rms about its plane; the plane slopes %.2f deg along x, %.2f deg along y "
                 "(in the map, after the registry's tilt)\n",
                 plane->cells, plane->rms, -l.pitch * 180.0 / M_PI, l.roll * 180.0 / M_PI);
+    if (!station.levelling() && std::hypot(l.roll, l.pitch) > 0.5 * M_PI / 180.0)
+      std::printf("  warning: a road this steep is more likely a LiDAR tilted other than the registry says (roll_deg, pitch_deg): "
+                  "--level-from-ground takes the tilt from the road\n");
   }
 }
 
@@ -124,6 +131,7 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
   roadside::RsuStationConfig config;
   config.coverage = rsu.coverage_radius;
   config.commissioning_frames = std::max(1, s.commission);
+  config.level_from_ground = s.level_from_ground;
   roadside::RsuStation station(mountOf(rsu), config);
   // Commissioning: the background and the road from the log's first frames, before any fix.
   std::map<Stamp, Eigen::Vector2d> truth;
@@ -224,6 +232,7 @@ void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, con
   roadside::RsuStationConfig config;
   config.coverage = rsu.coverage_radius;
   config.commissioning_frames = std::max(1, s.commission);
+  config.level_from_ground = s.level_from_ground;
   roadside::RsuStation station(mountOf(rsu), config);
   std::mutex station_mutex;
   const double variance = registry.variance(rsu);
@@ -329,6 +338,8 @@ void addRsuNodeCommand(CLI::App& app) {
   cmd->add_option("--commission", s.commission, "frames the background and the road are learned from before the first fix")
       ->check(wholeNumber(1, 100000))
       ->capture_default_str();
+  cmd->add_flag("--level-from-ground", s.level_from_ground,
+                "take the LiDAR's roll and pitch from the road it sees while commissioning (the tilt to the road) instead of the registry's");
   cmd->add_option("--frame-time-offset", s.frame_time_offset,
                   "s from a frame's header stamp to when the vehicle is seen in it (half a sweep for a driver that stamps its start)")
       ->check(finiteNumber(-1.0, 1.0))

@@ -2,6 +2,7 @@
 // vehicle its CAMs point to, each on its own track.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "coloc/core/error.hpp"
@@ -160,6 +161,46 @@ TEST_F(Station, TimeGoingBackStartsTheVehiclesAfreshAndTheSecondPassIsFixedAsThe
   EXPECT_GE(fixes[0], 10);
   EXPECT_GE(fixes[1], fixes[0] - 1);
   EXPECT_EQ(station.counters().clock_resets, 1u);
+}
+
+// A pole's LiDAR pitched 1.9 deg down whose tilt the registry does not know: levelled from the road it
+// sees while commissioning, its fixes are as good as with the tilt known; unlevelled, 0.1-0.3 m off.
+TEST_F(Station, AnUnknownTiltIsTakenFromTheRoadWhileCommissioning) {
+  const auto passWith = [&](bool level) {
+    RsuMount told = mount_;
+    told.pitch = 0.0;  // the registry's word: level
+    RsuStationConfig config;
+    config.commissioning_frames = 10;
+    config.level_from_ground = level;
+    RsuStation station(told, config);
+    const std::vector<Car> away = {{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}};
+    place(away, 0.0);
+    for (int k = 0; k < 10; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+    const std::vector<Car> cars = {{-45, 6, 0, 0}, {-100, 0, 30, 0}, {-110, 0, 30, 0}};
+    std::vector<double> errors;
+    for (int k = 0; k < 25; ++k) {
+      const double t = 0.1 * k;
+      place(cars, t);
+      station.addVehicle(cam(1001, cars[0], t, 5.0));
+      for (const StationOutcome& o : station.frame(frame(), fromSeconds(t + 5.0)))
+        if (o.detection.found) errors.push_back((o.detection.position - at(cars[0], t)).norm());
+    }
+    std::sort(errors.begin(), errors.end());
+    if (level) {
+      EXPECT_TRUE(station.levelling());
+      EXPECT_NEAR(station.mount().pitch, mount_.pitch, 0.2 * M_PI / 180.0);
+      EXPECT_NEAR(station.levelling()->height, mount_.position.z(), 0.15);
+    }
+    return errors;
+  };
+  const std::vector<double> levelled = passWith(true), unlevelled = passWith(false);
+  ASSERT_GE(levelled.size(), 10u);
+  const double median = levelled[levelled.size() / 2];
+  const double median_unlevelled = unlevelled.empty() ? 1e9 : unlevelled[unlevelled.size() / 2];
+  std::printf("tilt unknown: levelled from the road %zu fixes, median %.3f m; unlevelled %zu fixes, median %.3f m\n", levelled.size(), median,
+              unlevelled.size(), median_unlevelled);
+  EXPECT_LT(median, 0.08);
+  EXPECT_GT(median_unlevelled, 2.0 * median);
 }
 
 TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {

@@ -34,6 +34,10 @@ struct RsuStationConfig {
   double forget_after = 10.0;     ///< s without a CAM after which a vehicle and its track are forgotten
   int commissioning_frames = 50;  ///< frames learned before the first fix
   int refresh_frames = 100;       ///< afterwards, the background is rebuilt from what was learned this often
+  /// Take the LiDAR's roll and pitch from the road its background shows (RoadSurface's plane in the
+  /// sensor frame) instead of the mount's: for a pole whose tilt nobody measured. The tilt to the road,
+  /// so a road's grade is counted as tilt.
+  bool level_from_ground = false;
   BackgroundConfig background = [] {
     BackgroundConfig b;
     b.decay = 1.0 / 3000.0;  // five minutes at 10 Hz: a car parked longer becomes background
@@ -78,6 +82,9 @@ class RsuStation {
   bool commissioned() const;
   const StationCounters& counters() const;
   const RsuMount& mount() const;
+  /// The LiDAR's roll, pitch and height over the road as its background showed them, once commissioned
+  /// with level_from_ground (then the mount's roll and pitch are these).
+  std::optional<Levelling> levelling() const;
   /// Connected vehicles whose CAM is recent enough to be kept (RsuStationConfig::forget_after).
   std::size_t vehiclesKnown() const;
   /// The road found in the background (its plane in the map frame), once commissioned.
