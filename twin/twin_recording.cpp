@@ -425,6 +425,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     bag.addTopic(topic(rsu_client::kCamTopic, io::kCamType));
   }
   std::mt19937_64 cam_rng(scenario.seed + 53);  // the recorded CAMs' errors: a stream of their own
+  // The size a CAM tells the RSUs (errors.cam_size_step).
+  const auto camSize = [step = errors.cam_size_step](double size) { return step > 0.0 ? std::max(step, std::round(size / step) * step) : size; };
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
@@ -572,7 +574,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         if (!at_capture || (at_capture->head<2>() - r.info.position).norm() > r.range) continue;
         std::normal_distribution<double> cam_error(0.0, 0.3);
         const Eigen::Vector2d cam_position = at_capture->head<2>() + Eigen::Vector2d(cam_error(connected_rng), cam_error(connected_rng));
-        roadside::VehicleDetection od = r.perception[0].detect(frame, at(capture), cam_position, at_capture->z(), other.body.length, other.body.width);
+        roadside::VehicleDetection od =
+            r.perception[0].detect(frame, at(capture), cam_position, at_capture->z(), camSize(other.body.length), camSize(other.body.width));
         const Eigen::Vector2d other_velocity = other.speed * Eigen::Vector2d(std::cos(at_capture->z()), std::sin(at_capture->z()));
         if (!od.found) {
           r.connected_consistency[j].miss();
@@ -592,7 +595,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const Eigen::Vector2d reference = seen.position + Eigen::Vector2d(cam(rng), cam(rng));
       roadside::VehicleDetection d;
       for (std::size_t v = 0; v < r.perception.size(); ++v) {
-        const roadside::VehicleDetection dv = r.perception[v].detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
+        const roadside::VehicleDetection dv = r.perception[v].detect(frame, at(capture), reference, seen.yaw, camSize(body.length), camSize(body.width));
         if (v == 0) {
           d = dv;
           summary.perception_seconds += d.processing_ms * 1e-3;
