@@ -29,6 +29,7 @@
 #include "coloc/twin/twin_recording.hpp"
 #include "commands.hpp"
 #include "dds_options.hpp"
+#include "log_options.hpp"
 #include "number_checks.hpp"
 #include "teardown_watchdog.hpp"
 
@@ -43,6 +44,7 @@ struct NodeSettings {
   std::string registry_path = "config/rsu.yaml", id, log, out_dir = "rsu_node_out";
   int commission = 50;
   bool level_from_ground = false;
+  bool recover = false;
   double frame_time_offset = 0.05;  // s from a frame's header stamp to the moment the vehicle is seen
   std::int64_t truth_station = -1;
   double duration = 0.0, idle = 0.0;
@@ -56,6 +58,15 @@ roadside::RsuMount mountOf(const rsu_client::RsuInfo& rsu) {
   m.roll = rsu.roll;
   m.pitch = rsu.pitch;
   return m;
+}
+
+// The station as this RSU and the command line set it up, live and offline alike.
+roadside::RsuStation stationFor(const NodeSettings& s, const rsu_client::RsuInfo& rsu) {
+  roadside::RsuStationConfig config;
+  config.coverage = rsu.coverage_radius;
+  config.commissioning_frames = std::max(1, s.commission);
+  config.level_from_ground = s.level_from_ground;
+  return roadside::RsuStation(mountOf(rsu), config);
 }
 
 roadside::ConnectedVehicle vehicleOf(const io::Cam& cam) {
@@ -120,7 +131,7 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
   const std::string points_topic = rsu_client::roadsidePointsTopic(rsu.id), fix_topic = rsu_client::addressedFixTopic(rsu.id);
   bool has_points = false, has_cams = false;
   {
-    const io::BagReader probe = io::BagReader::open(s.log);
+    const io::BagReader probe = io::BagReader::open(s.log, io::BagReadOptions{s.recover});
     for (const io::TopicInfo& t : probe.topics()) {
       has_points = has_points || t.name == points_topic;
       has_cams = has_cams || t.name == rsu_client::kCamTopic;
@@ -128,15 +139,11 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
   }
   if (!has_points) throw Error(s.log + ": has no topic " + points_topic + " (RSU " + rsu.id + "'s frames; `coloc simulate --rsu-frames` records them)");
   if (!has_cams) throw Error(s.log + ": has no topic " + std::string(rsu_client::kCamTopic) + " (the connected vehicles' CAMs)");
-  roadside::RsuStationConfig config;
-  config.coverage = rsu.coverage_radius;
-  config.commissioning_frames = std::max(1, s.commission);
-  config.level_from_ground = s.level_from_ground;
-  roadside::RsuStation station(mountOf(rsu), config);
+  roadside::RsuStation station = stationFor(s, rsu);
   // Commissioning: the background and the road from the log's first frames, before any fix.
   std::map<Stamp, Eigen::Vector2d> truth;
   {
-    io::BagReader bag = io::BagReader::open(s.log);
+    io::BagReader bag = io::BagReader::open(s.log, io::BagReadOptions{s.recover});
     io::BagMessage m;
     int learned = 0;
     while (bag.next(m)) {
@@ -160,7 +167,7 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
   fix_info.type = "nav_msgs/msg/Odometry";
   out.addTopic(fix_info);
   const double variance = registry.variance(rsu);
-  io::BagReader bag = io::BagReader::open(s.log);
+  io::BagReader bag = io::BagReader::open(s.log, io::BagReadOptions{s.recover});
   io::BagMessage m;
   std::vector<double> errors;
   replay::PlotSeries error_series, sd_series;  // the scored station's fixes against range
@@ -229,11 +236,7 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
 }
 
 void runLive(const NodeSettings& s, const rsu_client::RsuRegistry& registry, const rsu_client::RsuInfo& rsu) {
-  roadside::RsuStationConfig config;
-  config.coverage = rsu.coverage_radius;
-  config.commissioning_frames = std::max(1, s.commission);
-  config.level_from_ground = s.level_from_ground;
-  roadside::RsuStation station(mountOf(rsu), config);
+  roadside::RsuStation station = stationFor(s, rsu);
   std::mutex station_mutex;
   const double variance = registry.variance(rsu);
   const rsu_client::DdsConfig dds = ddsConfig(s.dds, "coloc_rsu_" + rsu.id);
@@ -334,6 +337,7 @@ void addRsuNodeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--id", s.id, "this RSU's id in the registry (default: the registry's only RSU)");
   cmd->add_option("--log", s.log, "offline: a log holding the RSU's frames (/rsu/<id>/points) and the CAMs (/v2x/cam)")->check(CLI::ExistingPath);
+  addRecoverFlag(cmd, s.recover);
   cmd->add_option("--out", s.out_dir, "offline: where fixes.csv and log/ (the fixes it would have sent) go")->capture_default_str();
   cmd->add_option("--commission", s.commission, "frames the background and the road are learned from before the first fix")
       ->check(wholeNumber(1, 100000))

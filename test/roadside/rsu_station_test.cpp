@@ -56,6 +56,11 @@ class Station : public ::testing::Test {
     v.width = std::round(car_.width * 10.0) / 10.0;
     return v;
   }
+  // Commissions `station` on `frames` frames of the street with every car far down the road.
+  void commissionOnAnEmptyStreet(RsuStation& station, int frames) {
+    place({{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}}, 0.0);
+    for (int k = 0; k < frames; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+  }
   RayCaster world_;
   VehicleBody car_;
   std::vector<int> cars_;
@@ -110,9 +115,7 @@ TEST_F(Station, InAQueueTheFrontCarIsFoundAndTheHalfHiddenOneRefusedNotSentWrong
   RsuStationConfig config;
   config.commissioning_frames = 20;
   RsuStation station(mount_, config);
-  const std::vector<Car> away = {{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}};
-  place(away, 0.0);
-  for (int k = 0; k < 20; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+  commissionOnAnEmptyStreet(station, 20);
   ASSERT_TRUE(station.commissioned());
   const double gap = 1.0;
   const std::vector<Car> queue = {{-30, 6, 0, 0}, {-30 - car_.length - gap, 6, 0, 0}, {-100, 0, 30, 0}};
@@ -145,9 +148,7 @@ TEST_F(Station, TimeGoingBackStartsTheVehiclesAfreshAndTheSecondPassIsFixedAsThe
   RsuStationConfig config;
   config.commissioning_frames = 10;
   RsuStation station(mount_, config);
-  const std::vector<Car> away = {{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}};
-  place(away, 0.0);
-  for (int k = 0; k < 10; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+  commissionOnAnEmptyStreet(station, 10);
   const std::vector<Car> cars = {{-40, 6, 0, 0}, {-100, 0, 30, 0}, {-110, 0, 30, 0}};
   int fixes[2] = {0, 0};
   for (int pass = 0; pass < 2; ++pass)
@@ -173,9 +174,7 @@ TEST_F(Station, AnUnknownTiltIsTakenFromTheRoadWhileCommissioning) {
     config.commissioning_frames = 10;
     config.level_from_ground = level;
     RsuStation station(told, config);
-    const std::vector<Car> away = {{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}};
-    place(away, 0.0);
-    for (int k = 0; k < 10; ++k) station.frame(frame(), fromSeconds(0.1 * k));
+    commissionOnAnEmptyStreet(station, 10);
     const std::vector<Car> cars = {{-45, 6, 0, 0}, {-100, 0, 30, 0}, {-110, 0, 30, 0}};
     std::vector<double> errors;
     for (int k = 0; k < 25; ++k) {
