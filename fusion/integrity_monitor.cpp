@@ -128,10 +128,20 @@ void IntegrityMonitor::onAnchorApplied(const std::string& source, const Eigen::V
 }
 
 void IntegrityMonitor::doubt(const std::string& reason, const Eigen::Vector2d& offset, Stamp now) {
-  if (status_.state == LocalizationState::kInitialising || status_.state == LocalizationState::kLost || !offset.allFinite()) return;
+  if (offset.allFinite()) doubt(reason, Eigen::Matrix2d(offset * offset.transpose()), now);
+}
+
+void IntegrityMonitor::doubt(const std::string& reason, const Eigen::Matrix2d& spread, Stamp now) {
+  if (status_.state == LocalizationState::kInitialising || status_.state == LocalizationState::kLost || !spread.allFinite()) return;
   enter(LocalizationState::kDegraded, Cause::kDoubt, reason, now);
   status_.doubted = true;
-  inflation_ = offset * offset.transpose();
+  inflation_ = spread;
+}
+
+void IntegrityMonitor::confirm(Stamp now) {
+  if (cause_ != Cause::kDoubt) return;
+  status_.doubted = false;
+  enter(LocalizationState::kLocalized, Cause::kNone, {}, now);
 }
 
 void IntegrityMonitor::onTick(Stamp now) {

@@ -24,6 +24,12 @@ class IntegrityMonitor {
   /// Another part of the system doubts the estimate by `offset` (x, y): degraded, its reported
   /// covariance covering the offset, until an anchor agrees with it (or the filter starts again).
   void doubt(const std::string& reason, const Eigen::Vector2d& offset, Stamp now);
+  /// The same with the places it might be instead given as `spread`, added to the reported x/y
+  /// covariance (the sum of each place's offset times itself covers every one of them within 1 sd).
+  void doubt(const std::string& reason, const Eigen::Matrix2d& spread, Stamp now);
+  /// The part that doubted vouches for the position after all: a doubt that nothing else has
+  /// overtaken ends (localized again).
+  void confirm(Stamp now);
   /// The filter's clock advanced to `now`.
   void onTick(Stamp now);
 

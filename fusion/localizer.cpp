@@ -484,6 +484,14 @@ void Localizer::doubt(const std::string& reason, const Eigen::Vector2d& offset) 
   if (impl_->initialized) impl_->integrity.doubt(reason, offset, impl_->history.latestStamp());
 }
 
+void Localizer::doubt(const std::string& reason, const Eigen::Matrix2d& spread) {
+  if (impl_->initialized) impl_->integrity.doubt(reason, spread, impl_->history.latestStamp());
+}
+
+void Localizer::confirm() {
+  if (impl_->initialized) impl_->integrity.confirm(impl_->history.latestStamp());
+}
+
 Verdict Localizer::feedPose(SourceId source, const PoseMeasurement& m) {
   return impl_->feed(source, SourceKind::kPose, m.stamp, makePoseRecord(m));
 }

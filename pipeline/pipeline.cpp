@@ -169,6 +169,8 @@ struct Pipeline::Impl {
   // A start given by hand is held against the map at the next scan and every start_check_interval
   // after, until an RSU's fix agrees with the filter.
   bool check_start = false;
+  bool start_ambiguous = false;  // the start check found another place that matches as well
+  static constexpr double kElsewhere = 1.0;  // m: a match landing farther from the estimate's is elsewhere
   Stamp next_start_check = 0, start_check_end = 0;
   fusion::LocalizationState last_state = fusion::LocalizationState::kInitialising;
   std::optional<rsu_client::FixChecker> checker;
@@ -290,10 +292,16 @@ struct Pipeline::Impl {
     ++report.starts;
     report.started_how = how;
     check_start = true;
+    start_ambiguous = false;
     next_start_check = 0;
     last_state = fusion::LocalizationState::kLocalized;
-    noteState();
     event(formatSeconds(stamp) + " started: " + how);
+    // Until the map has been asked, the filter has only a person's word for where it is.
+    if (ndt && !config.pipeline.start_check_radii.empty()) {
+      localizer.doubt("a pose given by hand, not yet held against the map", Eigen::Matrix2d::Zero().eval());
+      start_ambiguous = true;
+    }
+    noteState();
   }
 
   void tryStart() {
@@ -325,30 +333,63 @@ struct Pipeline::Impl {
 
   bool lost() const { return localizer.integrity().state == fusion::LocalizationState::kLost; }
 
-  // A pose given by hand is a person's guess, and NDT started from a wrong one confirms it: the first
-  // scan after it is also matched from rings around it. A clearly better match elsewhere makes the
-  // filter degraded, its reported covariance covering the distance, until an RSU's fix agrees.
+  // A pose given by hand is a person's guess, and NDT started from a wrong one confirms it: the scans
+  // after it are also matched from rings around it. A clearly better match elsewhere makes the filter
+  // degraded, its reported covariance covering the distance, until an RSU's fix agrees. A match
+  // elsewhere about as good means the map cannot tell the two places apart (a street alike along its
+  // length): degraded as well, until a later check finds the estimate's place clearly the best or an
+  // RSU's fix agrees, since a filter that may be metres off must not say it is localized.
   void checkStart(const ScanInput& scan, const fusion::Estimate& guess) {
     next_start_check = scan.stamp + fromSeconds(config.pipeline.start_check_interval);
-    if (!ndt || config.pipeline.start_check_radii.empty() || localizer.integrity().state != fusion::LocalizationState::kLocalized) return;
+    if (!ndt || config.pipeline.start_check_radii.empty()) return;
+    const fusion::IntegrityStatus& integrity = localizer.integrity();
+    const bool checkable = integrity.state == fusion::LocalizationState::kLocalized ||
+                           (start_ambiguous && integrity.state == fusion::LocalizationState::kDegraded && integrity.doubted);
+    if (!checkable) return;
     ndt::ScanOutcome at_start, best;
+    std::vector<ndt::Landing> landings;
     {
       std::lock_guard<std::mutex> using_ndt(ndt_use);
-      best = ndt->searchAround(*scan.cloud, scan.stamp, guess.pose, config.pipeline.start_check_radii, 8, guess.state[4], at_start);
+      best = ndt->searchAround(*scan.cloud, scan.stamp, guess.pose, config.pipeline.start_check_radii, 8, guess.state[4], at_start, kElsewhere, &landings);
     }
     ++report.start_checks;
-    if (!best.produced) return;
-    const Eigen::Vector2d offset = best.pose.pose.position.head<2>() - guess.pose.position.head<2>();
     const double own = at_start.produced ? at_start.alignment.nvtl : 0.0;
-    const bool elsewhere = !at_start.produced || (best.pose.pose.position - at_start.pose.pose.position).head<2>().norm() > 1.0;
-    if (!elsewhere || best.alignment.nvtl < own + config.pipeline.start_check_margin) return;
+    const double margin = config.pipeline.start_check_margin;
+    if (!best.produced || best.alignment.nvtl <= own - margin) {
+      if (start_ambiguous) {
+        start_ambiguous = false;
+        localizer.confirm();
+        noteState();
+      }
+      return;
+    }
+    // Every place that matches about as well or better, each counted once: the reported covariance
+    // covers each of them within one standard deviation.
+    std::vector<Eigen::Vector2d> places;
+    Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+    for (const ndt::Landing& l : landings) {
+      if (l.nvtl <= own - margin) continue;
+      const Eigen::Vector2d offset = l.position - guess.pose.position.head<2>();
+      bool seen = false;
+      for (const Eigen::Vector2d& p : places) seen = seen || (p - offset).norm() <= kElsewhere;
+      if (seen) continue;
+      places.push_back(offset);
+      spread += offset * offset.transpose();
+    }
+    const Eigen::Vector2d offset = best.pose.pose.position.head<2>() - guess.pose.position.head<2>();
+    const bool better = best.alignment.nvtl >= own + margin;
     std::ostringstream why;
     why.precision(3);
-    why << "NDT matches the map better " << offset.norm() << " m from the filter's estimate, which a pose given by hand started (NVTL " << best.alignment.nvtl << " against "
-        << own << ")";
-    localizer.doubt(why.str(), offset);
+    why << "NDT matches the map " << (better ? "better " : "as well ") << offset.norm() << " m from the filter's estimate, which a pose given by hand started (NVTL "
+        << best.alignment.nvtl << " against " << own;
+    if (places.size() > 1) why << "; " << places.size() << " such places";
+    why << ")";
+    localizer.doubt(why.str(), spread);
+    // Said even when the state stays degraded: what the map said is why it stays so.
+    if (last_state == fusion::LocalizationState::kDegraded) event(formatSeconds(scan.stamp) + " start check: " + why.str());
     noteState();
-    check_start = false;  // degraded now, until an RSU's fix agrees
+    start_ambiguous = !better;
+    if (better) check_start = false;  // degraded now, until an RSU's fix agrees
   }
 
   void forgetLearned() {

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "coloc/core/error.hpp"
@@ -82,14 +83,18 @@ void ReplayResult::writeErrorCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   out << "stamp_s,estimate_x,estimate_y,truth_x,truth_y,error_m,along_m,across_m,heading_error_deg,sd_x_m,sd_y_m,state\n";
-  // Each tick's reported deviations and state, by stamp (the last estimate given out at a stamp).
-  std::map<Stamp, std::size_t> tick;
-  for (std::size_t i = 0; i < fused.size() && i < fused_sd.size() && i < fused_localization.size(); ++i) tick[fused[i].stamp] = i;
+  // Each tick's reported deviations and state, by stamp. A stamp can carry two estimates (the tick's,
+  // then a restart's at the same stamp): the k-th error sample at a stamp is the k-th estimate's.
+  std::map<Stamp, std::vector<std::size_t>> tick;
+  for (std::size_t i = 0; i < fused.size() && i < fused_sd.size() && i < fused_localization.size(); ++i) tick[fused[i].stamp].push_back(i);
+  std::map<Stamp, std::size_t> used;
   char line[360];
   for (const ErrorSample& s : errors) {
     const auto t = tick.find(s.stamp);
-    const Eigen::Vector2d sd = t == tick.end() ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()) : fused_sd[t->second];
-    const char* state = t == tick.end() ? "" : fusion::toString(fused_localization[t->second]);
+    std::optional<std::size_t> i;
+    if (t != tick.end()) i = t->second[std::min(used[s.stamp]++, t->second.size() - 1)];
+    const Eigen::Vector2d sd = i ? fused_sd[*i] : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    const char* state = i ? fusion::toString(fused_localization[*i]) : "";
     std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%s\n", formatSeconds(s.stamp).c_str(), s.estimate.x(),
                   s.estimate.y(), s.truth.x(), s.truth.y(), s.error, s.along, s.across, s.heading_error * 180.0 / M_PI, sd.x(), sd.y(), state);
     out << line;

@@ -75,6 +75,12 @@ class Localizer {
   /// hand) doubts its position by `offset` (m, x and y): it becomes degraded, with `reason`, and its
   /// reported covariance covers the offset until an anchor's pose agrees with it.
   void doubt(const std::string& reason, const Eigen::Vector2d& offset);
+  /// The same where several places might be the vehicle's: `spread` is added to the reported x/y
+  /// covariance (the sum over the places of each offset times itself covers every one within 1 sd).
+  void doubt(const std::string& reason, const Eigen::Matrix2d& spread);
+  /// The part that doubted vouches for the position after all (a later search finds no place that
+  /// matches as well): a doubt that no other disagreement has overtaken since ends.
+  void confirm();
 
   Verdict feedPose(SourceId source, const PoseMeasurement& measurement);
   Verdict feedPose(std::string_view source, const PoseMeasurement& measurement);
