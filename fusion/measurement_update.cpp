@@ -141,6 +141,12 @@ bool applyUpdate(FilterState& state, const UpdateRecord& record) {
 }
 
 void predictAux(FilterState& state, const std::array<double, 3>& proc_dev, double dt) {
+  // The height follows the road's slope as the vehicle drives (ROS: pitch positive nose down), so that
+  // a late pose's height, applied at its own tick, is carried to now as Autoware carries it
+  // (z + vx * delay * sin(-pitch)). Roll and pitch are held: the state has no roll or pitch rate.
+  ScalarFilter& z = state.aux[kAuxZ];
+  const ScalarFilter& pitch = state.aux[kAuxPitch];
+  if (z.initialized && pitch.initialized) z.value += state.x[kVx] * dt * std::sin(-pitch.value);
   for (int a = 0; a < 3; ++a) {
     if (state.aux[a].initialized) state.aux[a].variance += (proc_dev[a] * dt) * (proc_dev[a] * dt);
   }

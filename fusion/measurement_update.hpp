@@ -38,7 +38,8 @@ double mahalanobisSquared(const FilterState& state, const UpdateRecord& record);
 /// innovation covariance is not positive definite, which validated input cannot produce.
 bool applyUpdate(FilterState& state, const UpdateRecord& record);
 
-/// Grows the aux filters' variances over one tick: var += (q dt)^2.
+/// One tick of the aux filters: the height moved along the slope (vx dt sin(-pitch)), each variance
+/// grown by (q dt)^2.
 void predictAux(FilterState& state, const std::array<double, 3>& proc_dev, double dt);
 
 }  // namespace coloc::fusion

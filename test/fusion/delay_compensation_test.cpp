@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "drive.hpp"
 
@@ -177,6 +178,54 @@ TEST(EstimateAt, PastStampGivesThatTicksStateAndLaterStampAPredictionWithoutChan
   EXPECT_GT(ahead.state_covariance(0, 0), now.state_covariance(0, 0));
   EXPECT_FALSE(localizer.estimateAt(kStart - kNanosPerSecond).has_value());
   EXPECT_TRUE(snapshot(localizer) == before);
+}
+
+// Uphill at 8 m/s on a 5 % slope, NDT's poses (height and pitch measured) arriving 0.2 s late: the
+// height at now is the road's there, not the height 0.2 s ago (8 cm lower), as Autoware carries a late
+// pose's height to now; between poses it keeps following the slope.
+TEST(DelayCompensation, ALatePosesHeightIsCarriedToNowAlongTheSlope) {
+  const Drive drive;
+  Localizer localizer = startedLocalizer();
+  const double pitch = -std::atan(0.05);  // nose up: uphill
+  const auto heightAt = [&](int k) { return drive.speed * k * toSeconds(kTick) * std::sin(-pitch); };
+  constexpr int kLate = 10;  // ticks: 0.2 s
+  for (int k = 1; k <= 200; ++k) {
+    driveTick(localizer, drive, k);
+    if (k % 5 == 0 && k > kLate) {
+      const int stamp = k - kLate;
+      PoseMeasurement m = ndtPoseAt(drive, stamp);
+      m.pose.position.z() = heightAt(stamp);
+      m.pose.orientation = quaternionFromRollPitchYaw(0.0, pitch, drive.truth(stamp).z());
+      m.covariance(2, 2) = 0.0225;
+      m.covariance(3, 3) = m.covariance(4, 4) = 0.000625;
+      ASSERT_TRUE(localizer.feedPose("ndt", m).applied());
+    }
+    if (k > 100) {
+      const Estimate e = *localizer.estimate();
+      EXPECT_NEAR(e.pose.position.z(), heightAt(k), 0.01) << "tick " << k;
+    }
+  }
+}
+
+// Where coloc differs from Autoware on purpose: the height's variance grows every tick (Autoware's
+// grows only when a pose is used), so that a gap without poses is reported as the uncertainty it is.
+TEST(DelayCompensation, TheHeightsVarianceGrowsEveryTickWhileNoPoseArrives) {
+  const Drive drive;
+  Localizer localizer = startedLocalizer();
+  for (int k = 1; k <= 50; ++k) {
+    driveTick(localizer, drive, k);
+    if (k % 5 == 0) {
+      PoseMeasurement m = ndtPoseAt(drive, k);
+      m.covariance(2, 2) = 0.0225;
+      m.covariance(3, 3) = m.covariance(4, 4) = 0.000625;
+      ASSERT_TRUE(localizer.feedPose("ndt", m).applied());
+    }
+  }
+  for (int k = 51; k <= 60; ++k) driveTick(localizer, drive, k);  // the last pose's smoothing steps end
+  const double before = localizer.estimate()->pose_covariance(2, 2);
+  for (int k = 61; k <= 150; ++k) driveTick(localizer, drive, k);  // 1.8 s without a pose
+  const double q = localizer.config().z_filter_proc_dev * toSeconds(kTick);
+  EXPECT_NEAR(localizer.estimate()->pose_covariance(2, 2) - before, 90 * q * q, 1e-9);
 }
 
 }  // namespace
