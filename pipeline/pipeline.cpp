@@ -214,7 +214,7 @@ struct Pipeline::Impl {
         step(static_cast<Duration>(std::llround(1e9 / c.fusion.predict_frequency))),
         now(options.clock ? options.clock : std::function<Stamp()>(rsu_client::systemNow)),
         localizer(c.fusion),
-        speed_scale_config{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory},
+        speed_scale_config{c.pipeline.speed_scale_estimation && options.map.has_value(), 5.0, c.pipeline.speed_scale_memory, c.pipeline.speed_scale_min_distance},
         yaw_rate_bias_config{c.pipeline.yaw_rate_bias_estimation && options.map.has_value(), 2.0, c.pipeline.yaw_rate_bias_memory},
         mount_yaw_config{c.pipeline.mount_yaw_estimation && options.map.has_value(), 5.0, c.pipeline.mount_yaw_memory},
         speed_scale(speed_scale_config),

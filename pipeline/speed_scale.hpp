@@ -17,7 +17,7 @@ struct SpeedScaleConfig {
   bool enabled = true;
   double chord = 5.0;          ///< m of odometry travel between the two poses of one comparison
   double memory = 500.0;       ///< m of travel over which old comparisons fade to 1/e
-  double min_distance = 15.0;  ///< m of odometry travel before the estimate is used
+  double min_distance = 5.0;   ///< m of odometry travel before the estimate is used (one chord)
   double max_error = 0.1;      ///< a scale further than this from 1 is refused (counted)
   /// The first chord starts at a pose whose successor agrees with it within this (travel against the
   /// odometry's): a lone bad match there would bias every comparison until the memory forgets it,
