@@ -152,8 +152,16 @@ AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen:
     for (int e = 1; e < 4; ++e)
       if (support[e] > support[face]) face = e;
     const Eigen::Vector2d side = fit.corners[(face + 1) % 4] - fit.corners[face];
-    const double expected = std::abs(side.normalized().dot(heading)) >= std::sqrt(0.5) ? length : width;
-    box.face_shortfall = std::max(0.0, expected - side.norm());
+    const bool length_face = std::abs(side.normalized().dot(heading)) >= std::sqrt(0.5);
+    box.face_shortfall = std::max(0.0, (length_face ? length : width) - side.norm());
+    box.width_face_alone = !length_face;
+    // How obliquely the LiDAR sees that face: the angle between the line of sight to its middle and its
+    // normal.
+    const Eigen::Vector2d middle = 0.5 * (fit.corners[face] + fit.corners[(face + 1) % 4]);
+    const Eigen::Vector2d normal(-side.y(), side.x());
+    const Eigen::Vector2d sight = middle - lidar;
+    if (normal.norm() > 1e-9 && sight.norm() > 1e-9)
+      box.face_obliquity = std::acos(std::min(1.0, std::abs(normal.normalized().dot(sight.normalized()))));
   }
   {
     const Eigen::Vector2d next = fit.corners[(nearest + 1) % 4] - a, previous = fit.corners[(nearest + 3) % 4] - a;

@@ -314,7 +314,8 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.fit_points = xy.size();
   out.corner_seen = box.corner_seen;
   out.face_shortfall = box.face_shortfall;
-  if (c.attribute && c.align_true_size && box.face_shortfall > c.max_face_shortfall) return finish(Refusal::kCornerNotSeen);
+  if (c.attribute && c.align_true_size && box.face_shortfall > (box.width_face_alone && box.face_obliquity >= c.oblique_face ? c.max_width_face_shortfall : c.max_face_shortfall))
+    return finish(Refusal::kCornerNotSeen);
   // The fit's heading against the CAM's (modulo a half turn: the L-shape cannot tell front from back).
   if (c.attribute && c.max_heading_disagreement > 0.0) {
     const double off = std::abs(wrapAngle(2.0 * (box.yaw - heading_prior))) / 2.0;

@@ -153,6 +153,24 @@ TEST(AlignmentPoint, APartOfOneFaceFallsShortByWhatIsNotSeenAndItsBoxIsOffByAbou
   }
 }
 
+TEST(AlignmentPoint, AFrontFaceSeenAloneSaysItIsOneAndHowObliquelyItIsSeen) {
+  std::mt19937 rng(10);
+  const Eigen::Vector2d truth(30.0, 1.0);
+  const double yaw = M_PI;  // coming at the LiDAR, whose line of sight meets the front 2 deg off square
+  const auto points = frontFace(truth, yaw, 1.4, rng);
+  const AlignedBox square = alignTrueSizeBox(fitLShape(points), points, Eigen::Vector2d::Zero(), kLength, kWidth, yaw);
+  EXPECT_TRUE(square.width_face_alone);
+  EXPECT_NEAR(square.face_obliquity, std::atan2(1.0, 30.0 - 0.5 * kLength), 0.02);
+  // The same face from a pole 8 m to the side: 18 deg off square, its near end the body's corner.
+  const Eigen::Vector2d pole(0.0, -8.0);
+  const AlignedBox oblique = alignTrueSizeBox(fitLShape(points), points, pole, kLength, kWidth, yaw);
+  EXPECT_TRUE(oblique.width_face_alone);
+  EXPECT_NEAR(oblique.face_obliquity, std::atan2(9.0, 30.0 - 0.5 * kLength), 0.02);
+  // A side seen alone is not a front.
+  const auto side = frontFace(truth, yaw + M_PI / 2, 3.0, rng);
+  EXPECT_FALSE(alignTrueSizeBox(fitLShape(side), side, Eigen::Vector2d::Zero(), kLength, kWidth, yaw).width_face_alone);
+}
+
 TEST(LShapeFit, TooFewPointsIsAnError) {
   EXPECT_THROW(fitLShape({Eigen::Vector2d(1, 1)}), Error);
 }
