@@ -84,11 +84,11 @@ Outcome drivePast(const LidarSpec& ideal, double height, double pitch_deg) {
 // The bar for the twin: a fix in at least 80 % of frames, median at most 15 cm, p90 at most 30 cm,
 // none over 50 cm sent (that one for every case), and each fix's covariance honest: at most 1 % of all
 // fixes beyond 3 sd. The paper's VLP-32C on its 2 m mast gives a fix in every frame. A 64-beam LiDAR
-// with even beams gives one in 89-90 % from 2 and 5 m and 80 % from 8 m (held at 85 / 85 / 78 %: from
-// 8 m, side faces seen alone at 44-60 m and a few returns under the 0.8 m cut are refused; front and
-// rear faces seen alone up to 0.6 m short are taken, which from 8 m was 61 of 84 frames before); the
-// VLP-32C's beams below -8.8 deg are 2-10 deg apart, and from 5 and 8 m most frames give no fix
-// (printed, not held).
+// with even beams gives one in 88-90 % from 2 and 5 m and 80 % from 8 m (held at 85 / 85 / 78 %: from
+// 8 m, side faces seen alone and a few returns under the 0.8 m cut are refused; front and rear faces
+// seen alone and obliquely up to 0.6 m short are taken, without which 8 m gave 61 of 84); the VLP-32C's
+// beams below -8.8 deg are 2-10 deg apart, and from 5 and 8 m most frames give no fix (printed, not
+// held).
 TEST(HighMount, FixesFromAMastAndFromPolesAreAccurateAndTheirCovarianceHonest) {
   struct Case {
     LidarSpec lidar;

@@ -153,7 +153,7 @@ TEST(AlignmentPoint, APartOfOneFaceFallsShortByWhatIsNotSeenAndItsBoxIsOffByAbou
   }
 }
 
-TEST(AlignmentPoint, AFrontFaceSeenAloneSaysItIsOneAndHowObliquelyItIsSeen) {
+TEST(AlignmentPoint, AFaceSeenAloneSaysWhetherItIsAFrontAndHowObliquelyItIsSeen) {
   std::mt19937 rng(10);
   const Eigen::Vector2d truth(30.0, 1.0);
   const double yaw = M_PI;  // coming at the LiDAR, whose line of sight meets the front 2 deg off square
@@ -164,11 +164,12 @@ TEST(AlignmentPoint, AFrontFaceSeenAloneSaysItIsOneAndHowObliquelyItIsSeen) {
   // The same face from a pole 8 m to the side: 18 deg off square, its near end the body's corner.
   const Eigen::Vector2d pole(0.0, -8.0);
   const AlignedBox oblique = alignTrueSizeBox(fitLShape(points), points, pole, kLength, kWidth, yaw);
-  EXPECT_TRUE(oblique.width_face_alone);
   EXPECT_NEAR(oblique.face_obliquity, std::atan2(9.0, 30.0 - 0.5 * kLength), 0.02);
-  // A side seen alone is not a front.
+  // A side seen alone is not a front; a corner seen, no face alone.
   const auto side = frontFace(truth, yaw + M_PI / 2, 3.0, rng);
   EXPECT_FALSE(alignTrueSizeBox(fitLShape(side), side, Eigen::Vector2d::Zero(), kLength, kWidth, yaw).width_face_alone);
+  const auto l_points = visibleL(truth, yaw + 0.4, 0.6, rng);
+  EXPECT_EQ(alignTrueSizeBox(fitLShape(l_points), l_points, Eigen::Vector2d::Zero(), kLength, kWidth, yaw + 0.4).face_obliquity, 0.0);
 }
 
 TEST(LShapeFit, TooFewPointsIsAnError) {

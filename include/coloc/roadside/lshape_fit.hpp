@@ -42,8 +42,9 @@ struct AlignedBox {
   /// (length or width, by the heading prior), m. A face seen whole ends at the vehicle's corners and the
   /// box still rests on a true one; a partial face's end is anywhere along the body.
   double face_shortfall = 0.0;
-  /// Without a seen corner: the one face seen is a front or rear face (across the heading prior), and
-  /// the angle between the line of sight to its middle and its normal, rad.
+  /// Without a seen corner: whether the one face seen is a front or rear face (across the heading
+  /// prior), and how obliquely the LiDAR sees it: the angle between the line of sight to its middle and
+  /// its normal, rad (0: square on).
   bool width_face_alone = false;
   double face_obliquity = 0.0;
   /// Returns along the two faces meeting at the alignment point (away from its ends): the face along
