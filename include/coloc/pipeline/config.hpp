@@ -103,8 +103,8 @@ struct PipelineSection {
   bool speed_scale_estimation = true;
   double speed_scale_memory = 500.0;  ///< m of travel over which old comparisons fade
   /// The learned scale is used from one chord (5 m) on: measured on the twin, waiting for three chords
-  /// (15 m) left the filter ahead of NDT over the first 15 m of every drive (the held-back start: 3.6 cm
-  /// fused against NDT's 1.4; from 5 m: 2.6), while one chord's scale, 0.6 % off on average at 2 cm of
+  /// (15 m) left the filter ahead of NDT over the first 15 m of every drive (config/scenarios/
+  /// uncalibrated_start.yaml: 3.8 cm fused against NDT's 1.0; from 5 m: 2.7), while one chord's scale, 0.6 % off on average at 2 cm of
   /// NDT noise (1.25 % at worst in eight drives, test SpeedScale.*), is better than none against the
   /// 0.5-2 % of real tyres (every site and speed of the experiment: the fused error equal or lower).
   double speed_scale_min_distance = 5.0;  ///< m
