@@ -39,6 +39,7 @@ const std::vector<EkfParam>& ekfParams() {
       {"integrity_degraded_after_gated", "poses", "poses of another source (NDT) gated in a row that make the filter degraded; 0 = off", &C::integrity_degraded_after_gated},
       {"integrity_dead_reckoning_limit", "s", "time without any pose applied that makes the filter degraded; 0 = off", &C::integrity_dead_reckoning_limit},
       {"integrity_anchor_memory", "s", "time of other poses applied after which one gated anchor pose (an outlier) no longer degrades the filter", &C::integrity_anchor_memory},
+      {"map_error_sd", "m", "the map's own error against the world (its survey's accuracy, per axis): added to the reported x/y covariance, not the filter's; 0 = the map is the world", &C::map_error_sd},
   };
   return params;
 }

@@ -46,7 +46,8 @@ void validate(const EkfConfig& c) {
       {"integrity_anchor_agreement", c.integrity_anchor_agreement},
       {"integrity_lost_min_distance", c.integrity_lost_min_distance},
       {"integrity_dead_reckoning_limit", c.integrity_dead_reckoning_limit},
-      {"integrity_anchor_memory", c.integrity_anchor_memory}};
+      {"integrity_anchor_memory", c.integrity_anchor_memory},
+      {"map_error_sd", c.map_error_sd}};
   for (const auto& [key, value] : non_negative) requireConfig(std::isfinite(value) && value >= 0.0, key, "must be finite and >= 0");
   requireConfig(std::isfinite(c.initial_vx_variance) && c.initial_vx_variance > 0.0, "initial_vx_variance", "must be finite and > 0");
   requireConfig(std::isfinite(c.initial_wz_variance) && c.initial_wz_variance > 0.0, "initial_wz_variance", "must be finite and > 0");
@@ -406,6 +407,7 @@ struct Localizer::Impl {
   }
 
   Estimate describe(const FilterState& s, Stamp stamp) const {
+    const double map_error_variance = config.map_error_sd * config.map_error_sd;
     Estimate e;
     e.stamp = stamp;
     e.state = s.x;
@@ -424,6 +426,7 @@ struct Localizer::Impl {
     e.localization = integrity.status().state;
     if (e.localization == LocalizationState::kDegraded || e.localization == LocalizationState::kLost)
       e.pose_covariance.topLeftCorner<2, 2>() += integrity.inflation();
+    e.pose_covariance.topLeftCorner<2, 2>().diagonal().array() += map_error_variance;
     e.linear_velocity = {s.x[kVx], 0.0, 0.0};
     e.angular_velocity = {0.0, 0.0, s.x[kWz]};
     for (int i = 1; i < 5; ++i) e.twist_covariance(i, i) = kInfinity;  // vy, vz, wx, wy are not estimated

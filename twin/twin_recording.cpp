@@ -725,6 +725,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
        << "pipeline:\n  initial_pose: [" << scenario.route_start.x() << ", " << scenario.route_start.y() << ", 0.0, " << scenario.route_heading
        << "]\nndt:\n  lidar_pose: [0.0, 0.0, " << scenario.vehicle_lidar_height << ", 0.0, 0.0, 0.0]\n"
        << "rsu:\n  registry: rsu.yaml\n  station_id: " << scenario.vehicle_station_id << "  # the ego's: its fixes are addressed to it\n";
+  // The map was surveyed to this (errors.map_position_sd): the reported covariance carries it, as a
+  // user gives their map's survey accuracy.
+  if (errors.map_position_sd > 0.0) fuse << "fusion:\n  map_error_sd: " << errors.map_position_sd << "  # the survey map's error per axis (errors.map_position_sd)\n";
   summary.drive_seconds = drive.duration();
   summary.wall_seconds = since(wall_start);
   return summary;

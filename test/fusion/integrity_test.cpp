@@ -2,6 +2,8 @@
 // covariance covers a disagreement it cannot yet resolve.
 #include <gtest/gtest.h>
 
+#include "drive.hpp"
+
 #include "coloc/fusion/localizer.hpp"
 #include "measurements.hpp"
 #include "motion_model.hpp"
@@ -181,4 +183,28 @@ TEST(Integrity, AMiscalibratedRsusSmallDisagreementDegradesButNeverMakesItLost) 
 }
 
 }  // namespace
+// The map's own error against the world is reported, never filtered: NDT's poses carry it whole and
+// alike from scan to scan, so averaging them cannot remove it.
+TEST(Integrity, TheMapsOwnErrorIsAddedToTheReportedCovarianceAndChangesNothingElse) {
+  fusion::EkfConfig with = coloc::testing::quietConfig();
+  with.map_error_sd = 0.05;
+  fusion::Localizer plain = coloc::testing::startedLocalizer(), mapped = coloc::testing::startedLocalizer(with);
+  const coloc::testing::Drive drive;
+  for (int k = 1; k <= 100; ++k) {
+    coloc::testing::driveTick(plain, drive, k);
+    coloc::testing::driveTick(mapped, drive, k);
+    if (k % 5 == 0) {
+      plain.feedPose("ndt", coloc::testing::ndtPoseAt(drive, k));
+      mapped.feedPose("ndt", coloc::testing::ndtPoseAt(drive, k));
+    }
+  }
+  const fusion::Estimate a = *plain.estimate(), b = *mapped.estimate();
+  EXPECT_EQ(a.state, b.state);
+  EXPECT_EQ(a.state_covariance, b.state_covariance);
+  EXPECT_DOUBLE_EQ(b.pose_covariance(0, 0), a.pose_covariance(0, 0) + 0.0025);
+  EXPECT_DOUBLE_EQ(b.pose_covariance(1, 1), a.pose_covariance(1, 1) + 0.0025);
+  EXPECT_DOUBLE_EQ(b.pose_covariance(0, 1), a.pose_covariance(0, 1));
+  EXPECT_DOUBLE_EQ(b.pose_covariance(5, 5), a.pose_covariance(5, 5));
+}
+
 }  // namespace coloc::fusion
