@@ -32,8 +32,8 @@ std::optional<double> groundHeight(const TileMap& map, const Eigen::Vector2d& xy
 }  // namespace
 
 ScanOutcome NdtPoseSource::matchFromEach(const PointCloud& scan, Stamp stamp, const Eigen::Vector2d& near, double vx,
-                                          const std::vector<Eigen::Matrix4d>& bases, ScanOutcome* first, bool as_scan, double apart,
-                                          std::vector<Landing>* elsewhere) {
+                                          const std::vector<Eigen::Matrix4d>& bases, ScanOutcome* first, bool as_scan,
+                                          std::vector<Landing>* landings) {
   ++counters_.searches;
   if (as_scan) ++counters_.scans;
   ScanOutcome out;
@@ -52,7 +52,6 @@ ScanOutcome NdtPoseSource::matchFromEach(const PointCloud& scan, Stamp stamp, co
     return out;
   }
   bool found = false;
-  Eigen::Vector2d first_landed = Eigen::Vector2d::Zero();
   for (std::size_t k = 0; k < bases.size(); ++k) {
     const AlignResult r = align(*target, cloud, bases[k] * base_to_lidar_, config_.ndt);
     counters_.align_ms_total += r.elapsed_ms;
@@ -61,13 +60,8 @@ ScanOutcome NdtPoseSource::matchFromEach(const PointCloud& scan, Stamp stamp, co
       first->points_used = cloud.size();
       if (r.accepted()) producePose(*first, stamp);
     }
-    // Where the LiDAR landed; the mounting is the same for every start, so distances between landings
-    // are the vehicle's.
-    const Eigen::Vector2d landed = (r.accepted() ? r.transform : Eigen::Matrix4d(bases[k] * base_to_lidar_)).block<2, 1>(0, 3);
-    if (k == 0) first_landed = landed;
-    if (apart > 0.0 && (k == 0 || (landed - first_landed).norm() <= apart)) continue;
     if (!r.accepted()) continue;
-    if (elsewhere && apart > 0.0) elsewhere->push_back({Eigen::Matrix4d(r.transform * base_to_lidar_.inverse()).block<2, 1>(0, 3), r.nvtl});
+    if (landings && k > 0) landings->push_back({Eigen::Matrix4d(r.transform * base_to_lidar_.inverse()).block<2, 1>(0, 3), r.nvtl});
     if (found && r.nvtl <= out.alignment.nvtl) continue;
     found = true;
     out.alignment = r;
@@ -95,7 +89,7 @@ ScanOutcome NdtPoseSource::searchHeading(const PointCloud& scan, Stamp stamp, co
 }
 
 ScanOutcome NdtPoseSource::searchAround(const PointCloud& scan, Stamp stamp, const Pose& around, const std::vector<double>& radii, int directions,
-                                        double vx, ScanOutcome& at_pose, double apart, std::vector<Landing>* elsewhere) {
+                                        double vx, ScanOutcome& at_pose, std::vector<Landing>* landings) {
   const Eigen::Matrix4d center = (Eigen::Translation3d(around.position) * around.orientation.normalized()).matrix();
   std::vector<Eigen::Matrix4d> bases = {center};
   for (const double r : radii)
@@ -108,7 +102,7 @@ ScanOutcome NdtPoseSource::searchAround(const PointCloud& scan, Stamp stamp, con
     }
   at_pose = ScanOutcome{};
   at_pose.detail = "no accepted match from the pose itself";
-  return matchFromEach(scan, stamp, around.position.head<2>(), vx, bases, &at_pose, false, apart, elsewhere);
+  return matchFromEach(scan, stamp, around.position.head<2>(), vx, bases, &at_pose, false, landings);
 }
 
 }  // namespace coloc::ndt

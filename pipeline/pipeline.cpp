@@ -346,29 +346,25 @@ struct Pipeline::Impl {
     const bool checkable = integrity.state == fusion::LocalizationState::kLocalized ||
                            (start_ambiguous && integrity.state == fusion::LocalizationState::kDegraded && integrity.doubted);
     if (!checkable) return;
-    ndt::ScanOutcome at_start, best;
+    ndt::ScanOutcome at_start;
     std::vector<ndt::Landing> landings;
     {
       std::lock_guard<std::mutex> using_ndt(ndt_use);
-      best = ndt->searchAround(*scan.cloud, scan.stamp, guess.pose, config.pipeline.start_check_radii, 8, guess.state[4], at_start, kElsewhere, &landings);
+      ndt->searchAround(*scan.cloud, scan.stamp, guess.pose, config.pipeline.start_check_radii, 8, guess.state[4], at_start, &landings);
     }
     ++report.start_checks;
     const double own = at_start.produced ? at_start.alignment.nvtl : 0.0;
     const double margin = config.pipeline.start_check_margin;
-    if (!best.produced || best.alignment.nvtl <= own - margin) {
-      if (start_ambiguous) {
-        start_ambiguous = false;
-        localizer.confirm();
-        noteState();
-      }
-      return;
-    }
-    // Every place that matches about as well or better, each counted once: the reported covariance
-    // covers each of them within one standard deviation.
+    // Every place elsewhere (more than kElsewhere from where the estimate's own match lands) that
+    // matches about as well or better, each counted once: the reported covariance covers each of them
+    // within one standard deviation.
+    const Eigen::Vector2d own_place = (at_start.produced ? at_start.pose.pose.position : guess.pose.position).head<2>();
     std::vector<Eigen::Vector2d> places;
     Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+    const ndt::Landing* best = nullptr;
     for (const ndt::Landing& l : landings) {
-      if (l.nvtl <= own - margin) continue;
+      if ((l.position - own_place).norm() <= kElsewhere || l.nvtl <= own - margin) continue;
+      if (!best || l.nvtl > best->nvtl) best = &l;
       const Eigen::Vector2d offset = l.position - guess.pose.position.head<2>();
       bool seen = false;
       for (const Eigen::Vector2d& p : places) seen = seen || (p - offset).norm() <= kElsewhere;
@@ -376,12 +372,20 @@ struct Pipeline::Impl {
       places.push_back(offset);
       spread += offset * offset.transpose();
     }
-    const Eigen::Vector2d offset = best.pose.pose.position.head<2>() - guess.pose.position.head<2>();
-    const bool better = best.alignment.nvtl >= own + margin;
+    if (!best) {  // nothing elsewhere as good: the map vouches for the estimate
+      if (start_ambiguous) {
+        start_ambiguous = false;
+        localizer.confirm();
+        noteState();
+      }
+      return;
+    }
+    const Eigen::Vector2d offset = best->position - guess.pose.position.head<2>();
+    const bool better = best->nvtl >= own + margin;
     std::ostringstream why;
     why.precision(3);
     why << "NDT matches the map " << (better ? "better " : "as well ") << offset.norm() << " m from the filter's estimate, which a pose given by hand started (NVTL "
-        << best.alignment.nvtl << " against " << own;
+        << best->nvtl << " against " << own;
     if (places.size() > 1) why << "; " << places.size() << " such places";
     why << ")";
     localizer.doubt(why.str(), spread);

@@ -84,11 +84,10 @@ class NdtPoseSource {
   /// Whether the map matches better away from a pose given by hand: the scan matched from the pose and
   /// from offsets on rings of `radii` (m) in `directions` directions, the best accepted match by NVTL
   /// returned (a search, not a scan, in the counters: the scan is matched as usual too); `at_pose`
-  /// gets the match from the pose itself. `apart` > 0: only matches that land more than `apart` m from
-  /// the pose's own match (from the pose, where that failed) compete: the best match elsewhere; each
-  /// of them, where the vehicle would be and its NVTL, goes to `elsewhere` when given.
+  /// gets the match from the pose itself; `landings`, when given, where each accepted match from the
+  /// rings puts the vehicle and its NVTL (for a caller that weighs every place, not only the best).
   ScanOutcome searchAround(const PointCloud& scan, Stamp stamp, const Pose& around, const std::vector<double>& radii, int directions, double vx,
-                           ScanOutcome& at_pose, double apart = 0.0, std::vector<Landing>* elsewhere = nullptr);
+                           ScanOutcome& at_pose, std::vector<Landing>* landings = nullptr);
 
   const NdtPoseSourceCounters& counters() const { return counters_; }
   const DynamicMap& map() const { return map_; }
@@ -101,10 +100,9 @@ class NdtPoseSource {
   /// The scan preprocessed once and matched from each base pose (the first also reported in `first`),
   /// the best accepted match by NVTL kept; the map is moved to `near`. `as_scan`: counted as one of
   /// this source's scans (a heading search's), else as a search only (the scan is matched as usual too).
-  /// `apart` > 0: matches landing within `apart` m of the first's (of the first base, where it
-  /// failed) do not compete.
+  /// `landings`: each accepted match but the first's, where it puts the vehicle and its NVTL.
   ScanOutcome matchFromEach(const PointCloud& scan, Stamp stamp, const Eigen::Vector2d& near, double vx, const std::vector<Eigen::Matrix4d>& bases,
-                            ScanOutcome* first, bool as_scan, double apart = 0.0, std::vector<Landing>* elsewhere = nullptr);
+                            ScanOutcome* first, bool as_scan, std::vector<Landing>* landings = nullptr);
   /// The vehicle's pose from an accepted alignment of the LiDAR: map_T_base = map_T_lidar * lidar_T_base.
   void producePose(ScanOutcome& out, Stamp stamp) const;
 
