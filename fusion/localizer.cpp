@@ -69,6 +69,13 @@ std::array<double, 4> gateThresholds(double alpha) {
   return t;
 }
 
+// One sample's 95 % band per dimension: the chi-square's 2.5 % and 97.5 % quantiles.
+std::array<std::pair<double, double>, 4> sampleNisBands() {
+  std::array<std::pair<double, double>, 4> b{};
+  for (int m = 1; m <= 3; ++m) b[m] = {chiSquareQuantile(m, 0.975), chiSquareQuantile(m, 0.025)};
+  return b;
+}
+
 }  // namespace
 
 struct Localizer::Impl {
@@ -98,6 +105,7 @@ struct Localizer::Impl {
   EkfConfig config;
   StateHistory history;
   std::array<double, 4> pose_gate, twist_gate;
+  std::array<std::pair<double, double>, 4> nis_band = sampleNisBands();
   bool initialized = false;
   bool clock_set = false;
   Stamp clock = 0;
@@ -192,6 +200,14 @@ struct Localizer::Impl {
     // fixed in the record, so every use and replay linearizes the same model at its own state.
     if (src.kind == SourceKind::kPose && config.pose_time_alignment) record.time_offset = toSeconds(stamp - history.stampAt(back));
     const double d2 = mahalanobisSquared(history.stateAt(back), record);
+    if (record.m > 0 && std::isfinite(d2)) {
+      SourceCounters& c = src.counters;
+      ++c.nis_samples;
+      c.nis_dof += static_cast<std::uint64_t>(record.m);
+      c.nis_sum += d2;
+      c.nis_above += d2 > nis_band[record.m].second ? 1 : 0;
+      c.nis_below += d2 < nis_band[record.m].first ? 1 : 0;
+    }
     const auto& gate = src.kind == SourceKind::kPose ? pose_gate : twist_gate;
     std::string note;
     if (record.m > 0 && !(d2 <= gate[record.m])) {

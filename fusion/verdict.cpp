@@ -1,5 +1,7 @@
 #include "coloc/fusion/verdict.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace coloc::fusion {
@@ -54,6 +56,16 @@ std::string Verdict::message() const {
     out << " " << ticks_back << " ticks back (squared Mahalanobis distance " << mahalanobis_squared << ")";
   if (!detail.empty()) out << ": " << detail;
   return out.str();
+}
+
+std::pair<double, double> nisBand(std::uint64_t dof) {
+  if (dof == 0) return {0.0, 0.0};
+  // Wilson-Hilferty: (X/k)^(1/3) is nearly normal with mean 1 - 2/(9k) and variance 2/(9k); the
+  // quantiles over k are within 1 % of the exact ones from k = 10 on.
+  const double k = static_cast<double>(dof);
+  const double v = 2.0 / (9.0 * k);
+  const auto at = [&](double z) { return std::pow(std::max(0.0, 1.0 - v + z * std::sqrt(v)), 3.0); };
+  return {at(-1.959964), at(1.959964)};
 }
 
 }  // namespace coloc::fusion

@@ -251,7 +251,7 @@ Matrix6d multiNdtScoreCovariance(const NdtTarget::Impl& t, const std::vector<Eig
   Eigen::Matrix2d xy = Eigen::Matrix2d::Zero();
   for (std::size_t i = 0; i < w.size(); ++i) xy += w[i] * (offsets[i] - mean) * (offsets[i] - mean).transpose();
 
-  Matrix6d covariance = Matrix6d(config.fixed_covariance.asDiagonal());
+  Matrix6d covariance = Matrix6d(config.covariance_floor.asDiagonal());
   const Eigen::Matrix2d floor = heading * covariance.topLeftCorner<2, 2>() * heading.transpose();
   covariance.topLeftCorner<2, 2>() = floor.allFinite() ? floorCovariance(xy, floor) : floor;
   if (config.score_yaw_offset_deg > 0.0) {
@@ -309,7 +309,7 @@ AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, cons
 
   Matrix6d covariance;
   switch (config.covariance) {
-    case CovarianceMode::kLaplace: covariance = laplaceCovariance(eval.hessian, config.fixed_covariance); break;
+    case CovarianceMode::kLaplace: covariance = laplaceCovariance(eval.hessian, config.covariance_floor); break;
     case CovarianceMode::kMultiNdtScore:
       covariance = multiNdtScoreCovariance(t, source.points, opt.pose, result.nvtl, config, fast ? &cache : nullptr);
       break;

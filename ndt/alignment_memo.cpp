@@ -96,13 +96,13 @@ AlignmentMemoStats AlignmentMemo::stats() const {
 std::string configFingerprint(const NdtPoseSourceConfig& c) {
   // Field by field (padding bytes are not part of a value). A field added to these structs must be
   // added here too, or sources differing only in it would share outcomes: the sizes below catch it.
-  static_assert(sizeof(NdtConfig) == 144, "NdtConfig changed: fingerprint the new field");
+  static_assert(sizeof(NdtConfig) == 192, "NdtConfig changed: fingerprint the new field");
   static_assert(sizeof(PreprocessConfig) == 48, "PreprocessConfig changed: fingerprint the new field");
   static_assert(sizeof(MapUpdateConfig) == 24, "MapUpdateConfig changed: fingerprint the new field");
   std::string out;
   const NdtConfig& n = c.ndt;
   append(out, n.backend, n.neighborhood, n.resolution, n.step_size, n.transformation_epsilon, n.max_iterations, n.outlier_ratio, n.threads,
-         n.nvtl_threshold, n.max_oscillations, n.covariance, n.fixed_covariance, n.score_temperature, n.score_yaw_offset_deg);
+         n.nvtl_threshold, n.max_oscillations, n.covariance, n.fixed_covariance, n.covariance_floor, n.score_temperature, n.score_yaw_offset_deg);
   const PreprocessConfig& p = c.preprocess;
   append(out, p.min_range, p.max_range, p.deskew, p.voxel_size, p.max_points, p.seed);
   append(out, c.map.radius, c.map.update_distance, c.map.background, c.lidar_pose);

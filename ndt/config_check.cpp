@@ -30,6 +30,8 @@ void validate(const NdtPoseSourceConfig& c) {
   for (int i = 0; i < 6; ++i)
     require(c.ndt.fixed_covariance[i] > 0.0 && !std::isnan(c.ndt.fixed_covariance[i]), "fixed_covariance",
             "variances must be > 0 (.inf for not measured)");
+  for (int i = 0; i < 6; ++i)
+    require(c.ndt.covariance_floor[i] > 0.0 && std::isfinite(c.ndt.covariance_floor[i]), "covariance_floor", "variances must be finite and > 0");
   require(std::isfinite(c.ndt.score_temperature) && c.ndt.score_temperature > 0.0, "score_temperature", "must be a finite number > 0");
   require(std::isfinite(c.ndt.score_yaw_offset_deg) && c.ndt.score_yaw_offset_deg >= 0.0 && c.ndt.score_yaw_offset_deg <= 45.0,
           "score_yaw_offset_deg", "must be in [0, 45] deg (0 = no yaw probes)");

@@ -10,8 +10,7 @@ void OdometryIntegral::add(Stamp stamp, double rate) {
   const double integral =
       marks_.empty() ? 0.0 : marks_.back().integral + 0.5 * (rate + marks_.back().rate) * toSeconds(stamp - marks_.back().stamp);
   marks_.push_back({stamp, rate, integral});
-  // Enough to reach a pose stamped a sweep and a match ago.
-  while (marks_.size() > 2 && marks_.front().stamp < stamp - 2 * kNanosPerSecond) marks_.pop_front();
+  while (marks_.size() > 2 && marks_.front().stamp < stamp - span_) marks_.pop_front();
 }
 
 double OdometryIntegral::at(Stamp stamp) const {

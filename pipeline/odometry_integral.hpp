@@ -11,6 +11,8 @@ namespace coloc::pipeline {
 
 class OdometryIntegral {
  public:
+  /// Keeps the rates of the last `span` (enough to reach a pose stamped a sweep and a match ago).
+  explicit OdometryIntegral(Duration span = 2 * kNanosPerSecond) : span_(span) {}
   /// A rate at `stamp`. Non-finite rates and stamps not after the last are ignored: the integral keeps
   /// its course.
   void add(Stamp stamp, double rate);
@@ -23,6 +25,7 @@ class OdometryIntegral {
     Stamp stamp;
     double rate, integral;
   };
+  Duration span_;
   std::deque<Mark> marks_;
 };
 

@@ -1,5 +1,6 @@
 #include "coloc/pipeline/pipeline.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "inbox.hpp"
 #include "initializer.hpp"
 #include "speed_scale.hpp"
+#include "travel_check.hpp"
 #include "mount_yaw.hpp"
 #include "yaw_rate_bias.hpp"
 
@@ -46,6 +48,14 @@ struct NdtResult {
   std::uint64_t timeline;  ///< the pipeline's timeline when the scan was submitted (see Impl::timeline)
 };
 using Input = std::variant<ScanInput, TwistInput, PoseInput, FixInput, InitialPoseInput, NdtResult>;
+
+// The covariance with every direction's variance raised to at least sd^2.
+Eigen::Matrix2d atLeast(const Eigen::Matrix2d& covariance, double sd) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> e(covariance);
+  if (e.info() != Eigen::Success) return covariance;
+  const Eigen::Vector2d raised = e.eigenvalues().cwiseMax(sd * sd);
+  return e.eigenvectors() * raised.asDiagonal() * e.eigenvectors().transpose();
+}
 
 Stamp stampOf(const Input& input) {
   return std::visit(
@@ -181,6 +191,7 @@ struct Pipeline::Impl {
   SpeedScaleEstimator speed_scale;
   YawRateBiasEstimator yaw_rate_bias;
   MountYawEstimator mount_yaw;
+  TravelCheck travel_check;
   Eigen::Isometry3d base_to_lidar = Eigen::Isometry3d::Identity();  // the configured extrinsic
   bool first_input_seen = false;
   Stamp clock = 0;
@@ -219,7 +230,9 @@ struct Pipeline::Impl {
         mount_yaw_config{c.pipeline.mount_yaw_estimation && options.map.has_value(), 5.0, c.pipeline.mount_yaw_memory},
         speed_scale(speed_scale_config),
         yaw_rate_bias(yaw_rate_bias_config),
-        mount_yaw(mount_yaw_config) {
+        mount_yaw(mount_yaw_config),
+        travel_check(TravelCheckConfig{options.map.has_value() ? c.pipeline.travel_check_window : 0.0, c.pipeline.travel_check_tolerance,
+                                       c.pipeline.travel_check_tolerance_per_metre}) {
     const Vector6d& e = c.ndt.source.lidar_pose;
     base_to_lidar = Eigen::Translation3d(e.head<3>()) * Eigen::Quaterniond(quaternionFromRollPitchYaw(e[3], e[4], e[5]));
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
@@ -398,6 +411,7 @@ struct Pipeline::Impl {
 
   void forgetLearned() {
     speed_scale = SpeedScaleEstimator(speed_scale_config);
+    travel_check.reset();
     yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
     mount_yaw = MountYawEstimator(mount_yaw_config);
   }
@@ -485,6 +499,17 @@ struct Pipeline::Impl {
     // and the mounting yaw (each from NDT's poses as matched: the yaw's differences do not see it).
     // Not while the filter is lost or its position doubted by the map: NDT's poses may then match
     // another place, and what they would teach about the odometry is not the vehicle's.
+    // Where NDT's travel disagrees with the odometry's, its pose is worth no more than the disagreement.
+    // A pose with nothing to compare yet is taken at no better than the unverified figure.
+    const std::optional<Eigen::Vector2d> excess = travel_check.check(pose.stamp, pose.pose.position.head<2>(), rollPitchYaw(pose.pose.orientation)[2]);
+    if (!excess) {
+      pose.covariance.topLeftCorner<2, 2>() = atLeast(pose.covariance.topLeftCorner<2, 2>(), config.pipeline.travel_check_unverified_sd);
+      ++report.ndt_travel_unverified;
+    } else if (excess->squaredNorm() > 0.0) {
+      pose.covariance.topLeftCorner<2, 2>() += *excess * excess->transpose();
+      ++report.ndt_travel_disagreements;
+      report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
+    }
     const fusion::IntegrityStatus& integrity = localizer.integrity();
     if (!feedPose(ndt_id, pose).rejected() && integrity.state != fusion::LocalizationState::kLost && !integrity.doubted) {
       speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
@@ -542,6 +567,7 @@ struct Pipeline::Impl {
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
+        travel_check.addSpeed(t.stamp, t.linear.x());
       }
       if (std::isfinite(t.covariance(5, 5))) {
         yaw_rate_bias.addTwist(t.stamp, t.angular.z());

@@ -13,7 +13,14 @@ std::string sourcesJson(const std::vector<fusion::SourceReport>& sources) {
         {"too_old", c.too_old},     {"from_future", c.from_future}, {"invalid", c.invalid},
         {"not_initialized", c.not_initialized}, {"numerical", c.numerical}, {"pending", c.pending},
         {"smoothing_shortened", c.smoothing_shortened}, {"gate_recovered", c.gate_recovered}};
-    list.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"}, {"counters", counters}});
+    const auto band = fusion::nisBand(c.nis_dof);
+    const nlohmann::ordered_json nis = {{"samples", c.nis_samples},
+                                        {"dof", c.nis_dof},
+                                        {"mean_per_dof", c.nis_dof ? c.nis_sum / static_cast<double>(c.nis_dof) : 0.0},
+                                        {"band_95", {band.first, band.second}},
+                                        {"above_97_5", c.nis_above},
+                                        {"below_2_5", c.nis_below}};
+    list.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"}, {"counters", counters}, {"nis", nis}});
   }
   return list.dump();
 }

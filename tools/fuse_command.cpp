@@ -49,6 +49,17 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 (unsigned long long)c.from_future, (unsigned long long)c.invalid, (unsigned long long)c.not_initialized,
                 (unsigned long long)c.pending);
   }
+  std::printf("\n  %-22s %8s %13s %15s %10s %10s  (normalized innovation squared at first use: honest covariances\n"
+              "  %-22s %8s %13s %15s %10s %10s   give 1 per degree of freedom, 2.5 %% of samples above and below)\n",
+              "source", "samples", "NIS per dof", "95 % band", "above", "below", "", "", "", "", "", "");
+  for (const auto& s : r.sources) {
+    const auto& c = s.counters;
+    if (!c.nis_samples) continue;
+    const auto band = fusion::nisBand(c.nis_dof);
+    const double n = static_cast<double>(c.nis_samples);
+    std::printf("  %-22s %8llu %13.3f %7.3f-%-7.3f %9.1f%% %9.1f%%\n", s.name.c_str(), (unsigned long long)c.nis_samples,
+                c.nis_sum / static_cast<double>(c.nis_dof), band.first, band.second, 100.0 * c.nis_above / n, 100.0 * c.nis_below / n);
+  }
   for (const auto& [id, c] : r.fixes) std::printf("  %s\n", fixLine(id, r.pipeline_report).c_str());
   std::printf("  localization: %s\n", localizationLine(r.pipeline_report).c_str());
   for (const std::string& line : r.pipeline_report.first_events) std::printf("    %s\n", line.c_str());
@@ -65,6 +76,10 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     const Vector6d& l = r.lidar_pose;
     std::printf("  LiDAR on the vehicle: [%.3f, %.3f, %.3f] m, roll %.2f, pitch %.2f, yaw %.2f deg, from %s\n", l[0], l[1], l[2], l[3] * 180.0 / M_PI,
                 l[4] * 180.0 / M_PI, l[5] * 180.0 / M_PI, r.lidar_pose_from.c_str());
+    std::printf("  NDT's travel against the odometry's: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m), "
+                "%llu had none to compare yet\n",
+                (unsigned long long)r.pipeline_report.ndt_travel_disagreements,
+                r.pipeline_report.ndt_travel_max_excess, (unsigned long long)r.pipeline_report.ndt_travel_unverified);
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
     std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
     std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);

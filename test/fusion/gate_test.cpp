@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "drive.hpp"
 
@@ -111,6 +112,67 @@ TEST(Gate, TwistGateRejectsAnImpossibleSpeed) {
   Localizer localizer = startedLocalizer();
   const Verdict v = localizer.feedTwist("odom", twist(kStart, 300.0, 0.0, 0.01, 0.01));
   EXPECT_EQ(v.reason, Reason::kGated) << v.message();
+}
+
+}  // namespace
+}  // namespace coloc::fusion
+
+namespace coloc::fusion {
+namespace {
+
+// Fixes drawn with the spread their covariance states, `stated_over_true` times it, fed to a filter
+// standing still; the source's normalized innovation squared as counted.
+SourceCounters nisOfFixes(double stated_over_true) {
+  Localizer filter;
+  const SourceId odom = filter.addTwistSource("odom");
+  const SourceId rsu = filter.addPoseSource("/rsu/a/fix", 1, true);
+  Stamp now = testing::kStart;
+  filter.initialize(testing::planarPose(now, 0.0, 0.0, 0.0, 0.0225, 0.0001));
+  std::mt19937 rng(11);
+  const double variance = 0.02 * 0.02;
+  std::normal_distribution<double> noise(0.0, std::sqrt(variance));
+  for (int i = 0; i < 2000; ++i) {
+    for (int k = 0; k < 5; ++k) {
+      now += testing::kTick;
+      filter.feedTwist(odom, testing::twist(now, 0.0, 0.0, 1e-6, 1e-6));
+      filter.advanceTo(now);
+    }
+    filter.feedPose(rsu, testing::fix2d(now, noise(rng), noise(rng), variance * stated_over_true));
+  }
+  return filter.counters(rsu);
+}
+
+TEST(Consistency, HonestCovariancesGiveANormalizedInnovationOfOnePerDegreeOfFreedom) {
+  const SourceCounters c = nisOfFixes(1.0);
+  ASSERT_EQ(c.nis_samples, 2000u);
+  EXPECT_EQ(c.nis_dof, 4000u);
+  const double mean = c.nis_sum / static_cast<double>(c.nis_dof);
+  const auto band = nisBand(c.nis_dof);
+  EXPECT_GT(band.first, 0.9);
+  EXPECT_LT(band.second, 1.1);
+  // The filter's process noise (Autoware's, for a moving car) keeps its own variance a little above
+  // what standing still earns: slightly under 1.
+  EXPECT_GT(mean, 0.85);
+  EXPECT_LT(mean, band.second);
+  EXPECT_NEAR(c.nis_above / 2000.0, 0.025, 0.015);
+  EXPECT_NEAR(c.nis_below / 2000.0, 0.025, 0.02);
+}
+
+TEST(Consistency, AnOverconfidentSourceShowsAboveTheBandAndAConservativeOneBelow) {
+  const SourceCounters over = nisOfFixes(0.1);
+  EXPECT_GT(over.nis_sum / static_cast<double>(over.nis_dof), 3.0);
+  EXPECT_GT(over.nis_above / static_cast<double>(over.nis_samples), 0.2);
+  const SourceCounters under = nisOfFixes(10.0);
+  EXPECT_LT(under.nis_sum / static_cast<double>(under.nis_dof), 0.2);
+  EXPECT_GT(under.nis_below / static_cast<double>(under.nis_samples), 0.2);
+}
+
+TEST(Consistency, TheBandOfTheMeanNarrowsWithTheDegreesOfFreedomAsTheChiSquare) {
+  // chi-square(100) 2.5 % and 97.5 %: 74.22 and 129.56 (Wilson-Hilferty within 0.1 %).
+  const auto b = nisBand(100);
+  EXPECT_NEAR(b.first, 0.7422, 0.002);
+  EXPECT_NEAR(b.second, 1.2956, 0.002);
+  EXPECT_EQ(nisBand(0).first, 0.0);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // What became of one input: applied, waiting for the filter's clock, or rejected for a named reason.
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "coloc/core/time.hpp"
 
@@ -62,6 +63,18 @@ struct SourceCounters {
   std::uint64_t smoothing_shortened = 0;
   /// Applied although over the gate, at reduced weight, by gate recovery (pose_gate_recovery).
   std::uint64_t gate_recovered = 0;
+  /// How well the source's covariance describes it: its normalized innovation squared
+  /// d^2 = e' (H P H' + R)^-1 e at each first use (gated ones too), which a source and a filter whose
+  /// covariances are honest give as chi-square with the measured dimensions' degrees of freedom.
+  std::uint64_t nis_samples = 0;
+  std::uint64_t nis_dof = 0;      ///< the samples' degrees of freedom summed
+  double nis_sum = 0.0;           ///< their d^2 summed: nis_sum / nis_dof is 1 when honest
+  std::uint64_t nis_above = 0;    ///< samples above their chi-square's 97.5 % quantile (2.5 % if honest)
+  std::uint64_t nis_below = 0;    ///< samples below its 2.5 % quantile (2.5 % if honest)
 };
+
+/// The band the mean NIS per degree of freedom (nis_sum / nis_dof) lies in 95 % of the time when the
+/// covariances are honest: the chi-square(dof) quantiles over dof (Wilson-Hilferty), {lower, upper}.
+std::pair<double, double> nisBand(std::uint64_t dof);
 
 }  // namespace coloc::fusion

@@ -120,6 +120,17 @@ struct PipelineSection {
   /// on the twin (docs/experiment.md); the learned angle is reported either way.
   bool mount_yaw_estimation = false;
   double mount_yaw_memory = 500.0;  ///< m of travel over which old comparisons fade
+  /// Each NDT pose's chord from the pose travel_check_window earlier is held against the odometry's
+  /// distance over the same stamps (pipeline/travel_check.hpp); what it is off beyond the tolerance
+  /// is added to the pose's x/y covariance. NDT's covariance from its score says how sharply the scan
+  /// fits, not whether the fit is the right place; where NDT slides (a map out of date, a street
+  /// alike along its length) the odometry says so within a second.
+  double travel_check_window = 0.5;                ///< s; 0 = off
+  double travel_check_tolerance = 0.03;            ///< m
+  double travel_check_tolerance_per_metre = 0.005; ///< m per m of travel
+  /// A pose with no chord to compare yet (the first window after a start) is taken at no better than
+  /// this standard deviation in x and y (Autoware's fixed NDT covariance by default).
+  double travel_check_unverified_sd = 0.15;        ///< m
 };
 
 /// The Ceres smoother of recorded logs (coloc smooth, the experiment's smoother column). Its rate,

@@ -78,6 +78,11 @@ struct PipelineReport {
   double yaw_rate_bias_time = 0.0;           ///< s compared so far
   double mount_yaw = 0.0;                    ///< rad, NDT's heading minus the direction of travel (0 until known)
   double mount_yaw_distance = 0.0;           ///< m compared so far
+  /// NDT poses whose travel over pipeline.travel_check_window disagreed with the odometry's beyond the
+  /// tolerance (their covariance widened by the excess), and the largest excess, m.
+  std::uint64_t ndt_travel_disagreements = 0;
+  double ndt_travel_max_excess = 0.0;
+  std::uint64_t ndt_travel_unverified = 0;   ///< with no chord to compare yet, taken at travel_check_unverified_sd
   std::uint64_t rejections = 0;              ///< every refusal, of any kind
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };

@@ -1,0 +1,69 @@
+#include "travel_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace coloc::pipeline {
+
+namespace {
+
+double median(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  if (v.size() % 2) return *mid;
+  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
+}
+
+}  // namespace
+
+TravelCheck::TravelCheck(TravelCheckConfig config)
+    : config_(config), distance_(fromSeconds(3.0 * std::max(config.window, 0.0) + 1.0)) {}
+
+void TravelCheck::addSpeed(Stamp stamp, double speed) {
+  if (config_.window > 0.0) distance_.add(stamp, speed);
+}
+
+void TravelCheck::reset() {
+  distance_ = OdometryIntegral(fromSeconds(3.0 * std::max(config_.window, 0.0) + 1.0));
+  poses_.clear();
+}
+
+std::optional<Eigen::Vector2d> TravelCheck::check(Stamp stamp, const Eigen::Vector2d& position, double yaw) {
+  if (config_.window <= 0.0) return Eigen::Vector2d::Zero().eval();
+  if (!position.allFinite() || !std::isfinite(yaw)) return std::nullopt;
+  // Poses out of order (a late scan) are neither compared nor kept: chords run forward in time.
+  if (!poses_.empty() && stamp <= poses_.back().stamp) return std::nullopt;
+  const Stamp window = fromSeconds(config_.window);
+  while (!poses_.empty() && poses_.front().stamp < stamp - 2 * window) poses_.pop_front();
+  // Every kept pose one to two windows old starts a chord; the median of their disagreements is
+  // NDT's: a single bad match at either end of a chord does not make the other look bad.
+  std::vector<double> dx, dy;
+  std::vector<double> travels;
+  if (!distance_.empty()) {
+    const double here = distance_.at(stamp);
+    for (const Kept& from : poses_) {
+      if (from.stamp > stamp - window) break;
+      const double travelled = here - distance_.at(from.stamp);
+      const double heading = from.yaw + 0.5 * std::remainder(yaw - from.yaw, 2.0 * M_PI);
+      const Eigen::Vector2d difference = (position - from.position) - travelled * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      dx.push_back(difference.x());
+      dy.push_back(difference.y());
+      travels.push_back(std::abs(travelled));
+    }
+  }
+  poses_.push_back({stamp, position, yaw});
+  // One chord cannot tell which of its ends is wrong; of two, the one that agrees better is taken.
+  if (dx.size() < 2) return std::nullopt;
+  Eigen::Vector2d difference(median(dx), median(dy));
+  if (dx.size() == 2) {
+    const Eigen::Vector2d a(dx[0], dy[0]), b(dx[1], dy[1]);
+    difference = a.norm() <= b.norm() ? a : b;
+  }
+  const double tolerance = config_.tolerance + config_.tolerance_per_metre * median(travels);
+  const double norm = difference.norm();
+  if (norm <= tolerance) return Eigen::Vector2d::Zero().eval();
+  return (difference * ((norm - tolerance) / norm)).eval();
+}
+
+}  // namespace coloc::pipeline

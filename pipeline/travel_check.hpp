@@ -1,0 +1,52 @@
+#pragma once
+// NDT's travel held against the odometry's. NDT's covariance from its score (its curvature at the
+// optimum) describes how sharply the scan fits the map there, not whether the optimum is the right
+// one: where the map no longer matches (a building torn down) or the scene repeats along the road,
+// NDT can slide from scan to scan with a stated standard deviation of a centimetre, and a filter that
+// trusts it follows, feeding NDT its own drifted guess (site B's twin drive with the Laplace
+// covariance: 1.6 cm stated while NDT slid 1 m in 2 s). The odometry cannot tell where the vehicle
+// is, but over a second it tells how far it went within a few centimetres. So each NDT pose's chord
+// from each pose one to two windows earlier is compared with the odometry's distance over the same
+// stamps, laid along NDT's own mean heading (an arc's chord points there); the median difference's
+// part beyond the tolerance is what NDT's pose is worth no better than. A pose with no chord to
+// compare (the first second after a start) is unverified: one bad match there, taken at its own
+// sharp covariance, would hold the filter where the next good ones are gated away.
+#include <deque>
+#include <optional>
+#include <Eigen/Core>
+
+#include "coloc/core/time.hpp"
+#include "odometry_integral.hpp"
+
+namespace coloc::pipeline {
+
+struct TravelCheckConfig {
+  double window = 0.5;           ///< s: chords start at poses one to two windows old; 0 = off
+  double tolerance = 0.03;       ///< m of disagreement NDT's and the odometry's noise explain
+  double tolerance_per_metre = 0.005;  ///< and this much per metre of travel (the speed scale as learned)
+};
+
+class TravelCheck {
+ public:
+  explicit TravelCheck(TravelCheckConfig config = {});
+
+  /// The odometry's speed as the filter takes it (its learned scale applied), m/s.
+  void addSpeed(Stamp stamp, double speed);
+  /// An NDT pose: how far its travel is off the odometry's beyond the tolerance (zero when within
+  /// it, or when the check is off); nullopt when there is not enough to compare with yet (fewer than
+  /// two poses one to two windows old, no odometry) or the pose is not finite. The pose is kept as later chords' start.
+  std::optional<Eigen::Vector2d> check(Stamp stamp, const Eigen::Vector2d& position, double yaw);
+  void reset();
+
+ private:
+  struct Kept {
+    Stamp stamp;
+    Eigen::Vector2d position;
+    double yaw;
+  };
+  TravelCheckConfig config_;
+  OdometryIntegral distance_;
+  std::deque<Kept> poses_;
+};
+
+}  // namespace coloc::pipeline

@@ -1,0 +1,114 @@
+// NDT's travel held against the odometry's: a pose is widened by how far its travel over the last
+// second disagrees beyond the tolerance, and not by one bad match at a chord's other end.
+#include "travel_check.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace coloc::pipeline {
+namespace {
+
+constexpr Stamp kStart = 1'700'000'000'000'000'000LL;
+
+Stamp at(double t) { return kStart + static_cast<Stamp>(std::llround(t * 1e9)); }
+
+// A drive at `speed` along a heading of 30 deg: odometry at 50 Hz with 5 cm/s of white noise, NDT
+// poses at 10 Hz with 1 cm of noise plus `slide(t)` along the road. Returns each pose's excess.
+template <typename Slide>
+std::vector<std::optional<Eigen::Vector2d>> drive(double speed, double seconds, Slide slide, TravelCheckConfig config = {}) {
+  TravelCheck check(config);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> odometry_noise(0.0, 0.05), pose_noise(0.0, 0.01);
+  const double heading = 30.0 * M_PI / 180.0;
+  const Eigen::Vector2d along(std::cos(heading), std::sin(heading));
+  std::vector<std::optional<Eigen::Vector2d>> out;
+  for (int k = 0; k * 0.02 <= seconds; ++k) {
+    const double t = k * 0.02;
+    check.addSpeed(at(t), speed + odometry_noise(rng));
+    if (k % 5 == 0 && t >= 0.1) {
+      const double taken = t - 0.1;  // matched a sweep after its stamp
+      const Eigen::Vector2d p = (speed * taken + slide(taken)) * along + Eigen::Vector2d(pose_noise(rng), pose_noise(rng));
+      out.push_back(check.check(at(taken), p, heading));
+    }
+  }
+  return out;
+}
+
+TEST(TravelCheck, APoseWithNothingToCompareYetIsUnverified) {
+  const auto excess = drive(10.0, 3.0, [](double) { return 0.0; });
+  ASSERT_GT(excess.size(), 20u);
+  // Chords start at poses one to two windows (0.5 s) old, at least two of them: the first six poses
+  // have fewer.
+  for (int i = 0; i < 6; ++i) EXPECT_FALSE(excess[i].has_value()) << i;
+  for (std::size_t i = 6; i < excess.size(); ++i) EXPECT_TRUE(excess[i].has_value()) << i;
+}
+
+TEST(TravelCheck, NdtThatTravelsWithTheOdometryIsAlmostNeverWidened) {
+  // NDT's 1 cm at both ends and the odometry's 5 cm/s over the chord are within the 3 cm tolerance
+  // but for a rare draw, and then by millimetres.
+  for (const double speed : {0.0, 2.0, 10.0, 20.0}) {
+    const auto excess = drive(speed, 30.0, [](double) { return 0.0; });
+    int widened = 0, compared = 0;
+    for (const auto& e : excess)
+      if (e) {
+        ++compared;
+        widened += e->norm() > 0.0;
+        EXPECT_LT(e->norm(), 0.01) << speed << " m/s";
+      }
+    EXPECT_LT(widened, compared / 20) << speed << " m/s";
+  }
+}
+
+TEST(TravelCheck, NdtSlidingAlongTheRoadIsWidenedByItsSlideBeyondTheTolerance) {
+  // From 3 s on NDT slides ahead at 0.5 m/s (a scene alike along the road, a map out of date): over
+  // a chord of 0.5-1 s at 10 m/s that is 25-50 cm where the tolerance is 3 + 0.5 % of 5-10 m.
+  const auto excess = drive(10.0, 6.0, [](double t) { return t > 3.0 ? 0.5 * (t - 3.0) : 0.0; });
+  const double heading = 30.0 * M_PI / 180.0;
+  const Eigen::Vector2d along(std::cos(heading), std::sin(heading));
+  int widened = 0;
+  for (std::size_t i = 40; i < excess.size(); ++i) {  // from 4 s: the whole chord span slides
+    ASSERT_TRUE(excess[i].has_value());
+    const double norm = excess[i]->norm();
+    // The median chord is 0.75 s: 37.5 cm of slide, less the tolerance of 3 + 3.75 cm.
+    EXPECT_NEAR(norm, 0.375 - 0.0675, 0.04) << i;
+    EXPECT_GT(std::abs(excess[i]->dot(along)), 0.99 * norm) << "widened along the slide";
+    widened += norm > 0.0;
+  }
+  EXPECT_GT(widened, 15);
+}
+
+TEST(TravelCheck, OneBadMatchAtAChordsStartDoesNotWidenThePosesAfterIt) {
+  // The first match after a start 37 cm ahead (site C's twin drive started from a roadside fix), the
+  // rest good: chords from the bad one disagree, their median does not.
+  const auto excess = drive(10.0, 4.0, [](double t) { return t < 0.01 ? 0.37 : 0.0; });
+  for (const auto& e : excess)
+    if (e) EXPECT_EQ(e->norm(), 0.0);
+}
+
+TEST(TravelCheck, NonFiniteOrOutOfOrderPosesAreNeitherComparedNorKept) {
+  TravelCheck check;
+  for (int k = 0; k <= 100; ++k) check.addSpeed(at(0.02 * k), 10.0);
+  EXPECT_FALSE(check.check(at(0.1), Eigen::Vector2d(1.0, 0.0), 0.0).has_value());
+  EXPECT_FALSE(check.check(at(0.2), Eigen::Vector2d(2.0, 0.0), 0.0).has_value());
+  EXPECT_FALSE(check.check(at(0.9), Eigen::Vector2d(std::nan(""), 0.0), 0.0).has_value());
+  EXPECT_FALSE(check.check(at(0.15), Eigen::Vector2d(1.5, 0.0), 0.0).has_value()) << "older than the last kept";
+  const auto e = check.check(at(0.8), Eigen::Vector2d(8.0, 0.0), 0.0);
+  ASSERT_TRUE(e.has_value());
+  EXPECT_EQ(e->norm(), 0.0);
+}
+
+TEST(TravelCheck, AWindowOfZeroTurnsTheCheckOff) {
+  TravelCheckConfig off;
+  off.window = 0.0;
+  const auto excess = drive(10.0, 4.0, [](double t) { return t > 1.0 ? 2.0 * t : 0.0; }, off);
+  for (const auto& e : excess) {
+    ASSERT_TRUE(e.has_value());
+    EXPECT_EQ(e->norm(), 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace coloc::pipeline
