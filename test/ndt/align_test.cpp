@@ -147,12 +147,12 @@ TEST_F(RealPair, ScanFromAnotherPlaceIsRejectedByTheQualityGate) {
   EXPECT_FALSE(displaced.accepted()) << "nvtl " << displaced.nvtl;
 }
 
-TEST_F(RealPair, LaplaceCovarianceIsFlooredAtTheFixedOne) {
+TEST_F(RealPair, LaplaceCovarianceIsFlooredAtTheCovarianceFloor) {
   NdtConfig config;
   config.covariance = CovarianceMode::kLaplace;
   const AlignResult r = align(NdtTarget(*target_, config), *source_, Eigen::Matrix4d::Identity(), config);
   ASSERT_TRUE(r.accepted());
-  for (int i = 0; i < 6; ++i) EXPECT_GE(r.covariance(i, i), config.fixed_covariance[i] * (1 - 1e-12));
+  for (int i = 0; i < 6; ++i) EXPECT_GE(r.covariance(i, i), config.covariance_floor[i] * (1 - 1e-12));
   EXPECT_TRUE(r.covariance.isApprox(r.covariance.transpose()));
   Eigen::SelfAdjointEigenSolver<Matrix6d> eig(r.covariance);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);

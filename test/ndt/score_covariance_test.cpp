@@ -75,7 +75,7 @@ Outcome alignIn(bool blocks, double yaw, const NdtConfig& config) {
 NdtConfig scoreConfig() {
   NdtConfig c;
   c.covariance = CovarianceMode::kMultiNdtScore;
-  c.fixed_covariance << 0.001, 0.001, 0.0225, 0.000625, 0.000625, 1e-6;
+  c.covariance_floor << 0.001, 0.001, 0.0225, 0.000625, 0.000625, 1e-6;
   c.score_yaw_offset_deg = 0.5;
   return c;
 }
@@ -130,7 +130,7 @@ TEST(MultiNdtScoreCovariance, OpenGroundLeavesTheHeadingUncertainAndYawProbesSee
   EXPECT_GT(with_yaw.covariance(1, 1), 0.04);
   config.score_yaw_offset_deg = 0.0;  // Autoware's: x/y only, yaw at the fixed figure
   const AlignResult without = align(target, scan, Eigen::Matrix4d::Identity(), config);
-  EXPECT_DOUBLE_EQ(without.covariance(5, 5), config.fixed_covariance[5]);
+  EXPECT_DOUBLE_EQ(without.covariance(5, 5), config.covariance_floor[5]);
 }
 
 TEST(MultiNdtScoreCovariance, IsSymmetricPositiveDefiniteAndNeverBelowTheFloor) {
@@ -141,7 +141,7 @@ TEST(MultiNdtScoreCovariance, IsSymmetricPositiveDefiniteAndNeverBelowTheFloor) 
     EXPECT_TRUE(c.isApprox(c.transpose()));
     EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix6d>(c).eigenvalues().minCoeff(), 0.0);
     EXPECT_GE(o.along_across.minCoeff(), 0.001 * (1 - 1e-9));
-    for (int i = 2; i < 5; ++i) EXPECT_DOUBLE_EQ(c(i, i), config.fixed_covariance[i]);
+    for (int i = 2; i < 5; ++i) EXPECT_DOUBLE_EQ(c(i, i), config.covariance_floor[i]);
   }
 }
 
