@@ -291,6 +291,7 @@ struct Pipeline::Impl {
 
   // Starts (or restarts) the filter from a pose the initializer found, saying how and why.
   void start(const StartPose& start, const std::string& why) {
+    travel_check.reset();  // NDT's poses before a start are another story's: no chord spans it
     localizer.initialize(start.pose, initializer.twist());
     if (!localizer.initialized()) return;
     last_state = fusion::LocalizationState::kLocalized;
@@ -302,6 +303,7 @@ struct Pipeline::Impl {
 
   // A start from a pose given by hand: counted and said, and held against the map from the next scan.
   void startedByHand(const std::string& how, Stamp stamp) {
+    travel_check.reset();
     ++report.starts;
     report.started_how = how;
     check_start = true;
