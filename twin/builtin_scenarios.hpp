@@ -8,4 +8,7 @@ namespace coloc::twin {
 const char* builtinScenario(const char* name);
 inline const char* builtinScenario(const std::string& name) { return builtinScenario(name.c_str()); }
 
+/// The built-in scenarios' names, comma-separated, for messages.
+const char* builtinScenarioNames();
+
 }  // namespace coloc::twin

@@ -115,7 +115,7 @@ std::string scenarioText(const std::string& site) {
   try {
     return YamlReader::readFile(site, "scenario file");
   } catch (const Error&) {
-    throw Error(site + ": neither a built-in scenario (site_a, site_b, site_c) nor a readable scenario file");
+    throw Error(site + ": neither a built-in scenario (" + builtinScenarioNames() + ") nor a readable scenario file");
   }
 }
 
