@@ -222,7 +222,7 @@ namespace {
 // as the twin's do; NDT every 100 ms with 1 cm noise plus `ndt_bias` (a slowly varying error of
 // 1.5 cm, the same in x and y, period 20 s) claiming 15 cm; within 20 m of the miscalibrated RSU,
 // its fixes (2 mm).
-Smoother noisyDrive(const SmootherOptions& options, bool ndt_bias, std::uint32_t seed) {
+Smoother noisyDrive(const SmootherOptions& options, bool ndt_bias, std::uint32_t seed, bool map_matching = true) {
   Smoother s(options);
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01;
@@ -249,7 +249,7 @@ Smoother noisyDrive(const SmootherOptions& options, bool ndt_bias, std::uint32_t
       ndt.covariance = Matrix6d::Zero();
       ndt.covariance.diagonal() << 0.0225, 0.0225, kInfinity, kInfinity, kInfinity, 0.000625;
       s.addPose("ndt", ndt);
-      s.setPoseBias("ndt");
+      if (map_matching) s.setPoseBias("ndt");
     }
     if (k % 5 == 2 && (x.head<2>() - rsu_true).norm() < 20.0) {
       const Eigen::Vector2d reported = rsu_surveyed + Eigen::Rotation2Dd(error.z()) * (x.head<2>() - rsu_true);
@@ -267,7 +267,9 @@ const NoiseScale* noiseOf(const SmootherResult& r, const std::string& source) {
 }
 
 TEST(NoiseEstimation, ASourcesNoiseIsMeasuredOnTheDriveNotTakenFromItsMessages) {
-  const SmootherResult r = noisyDrive(SmootherOptions{}, false, 11).solve(at(0.0), at(12.0));
+  // The 1 cm poses as a source of independent poses (not map matching, whose error is shared from
+  // pose to pose: see the next test).
+  const SmootherResult r = noisyDrive(SmootherOptions{}, false, 11, false).solve(at(0.0), at(12.0));
   ASSERT_TRUE(r.summary.usable()) << r.summary.report;
   const NoiseScale* odom = noiseOf(r, "odom");
   const NoiseScale* ndt = noiseOf(r, "ndt");
@@ -277,6 +279,55 @@ TEST(NoiseEstimation, ASourcesNoiseIsMeasuredOnTheDriveNotTakenFromItsMessages) 
   EXPECT_LT(odom->scale, 0.25 * 1.3);
   // Claimed 15 cm, is 1 cm (x, y) and 0.002 rad against 0.025: about 1/15 and 1/12.
   EXPECT_NEAR(ndt->scale, 1.0 / 15.0, 0.5 / 15.0);
+}
+
+TEST(NoiseEstimation, MapMatchingPosesThatRepeatTheirGuessAlongACorridorDoNotOutvoteTheFixes) {
+  // A corridor at 10 m/s: along the road NDT's poses repeat the dead reckoning they started from
+  // (odometry 0.3 % fast, so 3 mm per metre ahead of the truth), across it they are 1 cm good; both
+  // claim 15 cm. Their scatter is a centimetre, their error along the road 20-30 cm where an RSU's
+  // 2 cm fixes come in (70-100 m). Taken at their scatter, they would outvote the fixes.
+  Smoother s;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  for (int k = 0; k <= 600; ++k) {
+    const double t = k * 0.02, v = 10.0;
+    const Vector6d x = (Vector6d() << v * t, 0.0, 0.0, 0.0, v, 0.0).finished();
+    TwistMeasurement tw;
+    tw.stamp = at(t);
+    tw.linear = {1.003 * v + 0.05 * n01(rng), 0.0, 0.0};
+    tw.angular = {0.0, 0.0, 0.005 * n01(rng)};
+    tw.covariance = Matrix6d::Zero();
+    tw.covariance.diagonal() << 0.04, kInfinity, kInfinity, kInfinity, kInfinity, 0.01;
+    s.addTwist("odom", tw);
+    s.addGuess(at(t), x);
+    if (k % 5 == 0) {
+      PoseMeasurement ndt;
+      ndt.stamp = at(t);
+      ndt.pose.position = {1.003 * x[0] + 0.002 * n01(rng), 0.01 * n01(rng), 0.0};
+      ndt.pose.orientation = quaternionFromRollPitchYaw(0.0, 0.0, 0.002 * n01(rng));
+      ndt.covariance = Matrix6d::Zero();
+      ndt.covariance.diagonal() << 0.0225, 0.0225, kInfinity, kInfinity, kInfinity, 0.000625;
+      s.addPose("ndt", ndt);
+      s.setPoseBias("ndt");
+    }
+    if (k % 5 == 2 && t >= 7.0 && t <= 10.0) s.addPose("/rsu/a/fix", fix(t, x[0] + 0.02 * n01(rng), x[1] + 0.02 * n01(rng), 4e-4));
+  }
+  const SmootherResult r = s.solve(at(0.0), at(12.0));
+  ASSERT_TRUE(r.summary.usable()) << r.summary.report;
+  double along = 0.0;
+  int samples = 0;
+  for (const SmoothedState& st : r.states) {
+    const double t = toSeconds(st.stamp - at(0.0));
+    if (t < 7.0 || t > 10.0) continue;
+    along += std::abs(st.state[0] - 10.0 * t);
+    ++samples;
+  }
+  ASSERT_GT(samples, 100);
+  // NDT there is 21-30 cm ahead; the fixes, averaged over a few, a centimetre or less.
+  EXPECT_LT(along / samples, 0.03);
+  const NoiseScale* ndt = noiseOf(r, "ndt");
+  ASSERT_TRUE(ndt);
+  EXPECT_GE(ndt->scale, 1.0);  // never taken as better than it says while its shared error is not modelled
 }
 
 TEST(OdometryCalibration, RecoversTheSpeedScaleAndGyroBiasFromAnAnchoredDrive) {
@@ -291,9 +342,9 @@ TEST(OdometryCalibration, RecoversTheSpeedScaleAndGyroBiasFromAnAnchoredDrive) {
 }
 
 TEST(PoseBias, WithABiasedAnchorTheCalibrationsUncertaintyCoversItsError) {
-  // NDT 1.5 cm off for seconds at a time anchors the RSU's calibration: taken as white noise, the
-  // survey offset comes out with a standard deviation of a millimetre or two and an error several
-  // times that; modelled, the uncertainty includes NDT's bias.
+  // NDT 1.5 cm off for seconds at a time anchors the RSU's calibration: without the bias modelled NDT
+  // is taken at its claimed 15 cm (never better: see above), so the calibration is uncertain but
+  // its error larger; modelled, the uncertainty includes NDT's bias and the estimate is better.
   int covered_without = 0, covered_with = 0;
   double error_with = 0.0, error_without = 0.0;  // mean over the seeds, m
   for (std::uint32_t seed = 21; seed < 26; ++seed) {
@@ -313,7 +364,6 @@ TEST(PoseBias, WithABiasedAnchorTheCalibrationsUncertaintyCoversItsError) {
     }
   }
   EXPECT_GE(covered_with, 4);
-  EXPECT_LE(covered_without, 2);
   // And the estimate itself is better: the bias is no longer read as the RSU's survey error.
   EXPECT_LT(error_with, 0.7 * error_without);
 }
