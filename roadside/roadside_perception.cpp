@@ -294,14 +294,21 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     const Object* vehicle = nullptr;
     double best = 1e9;
     int plausible = 0;
+    bool fitted = false;
     for (const Object* o : candidates) {
       std::vector<Eigen::Vector2d> o_xy;
       FittedRectangle o_fit;
       const AlignedBox o_box = fitBody(o->points, foreground, c, lidar, length, width, heading_prior, o_xy, &o_fit);
+      fitted = fitted || o_xy.size() >= 3;
       const double d = o_xy.size() < 3 ? 1e9 : (o_box.center - reference).norm();
       plausible += d <= R ? 1 : 0;
       if (d < best) best = d, vehicle = o, box = o_box, fit = o_fit, xy = std::move(o_xy);
     }
+    // Candidates with no returns on the lower body at all: hidden by something nearer, or a car passing
+    // close to a low mast, below its lowest beam (a VLP-16 2 m up sees nothing under 0.8 m nearer than
+    // 4.5 m). Nothing to fit, rather than a fit away from the CAM's position, as the RSU's operator
+    // should read it.
+    if (!fitted) return finish(occluding(nullptr) >= c.occlusion_points ? Refusal::kOccluded : Refusal::kTooFewPoints);
     if (occluding(vehicle) >= c.occlusion_points) return finish(Refusal::kOccluded);
     if (best > R) return finish(Refusal::kNotAtPosition);
     if (plausible > 1) return finish(Refusal::kAmbiguous);
