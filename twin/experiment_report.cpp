@@ -60,7 +60,7 @@ double improvement(double baseline, double fused) { return baseline > 0.0 ? 100.
 // percentage of it measures noise: Table I gives the ratio of fused to NDT there, and the improvement
 // only where NDT falls short (the paper's locations: 8-13 cm).
 constexpr double kNdtFallsShort = 0.05;  // m
-// "93 % (91-95)" where NDT falls short, "fused 0.48x NDT" where it does not.
+// "93 % (91-95)" where NDT falls short, "0.48x NDT" where it does not.
 std::string gainCell(double ndt, double fused, const Spread* range = nullptr) {
   if (ndt < kNdtFallsShort) return fmt("%.2fx NDT", ndt > 0.0 ? fused / ndt : 0.0);
   std::string cell = fmt("%.0f %%", improvement(ndt, fused));
@@ -158,7 +158,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   // Table I, with the main covariance and the reference one beside it.
   const std::string reference = std::string("covariance ") + toString(referenceCovariance(c.rsu_covariance));
   std::ostringstream table1, table1_csv;
-  table1 << "| site | roadside LiDAR | coverage | NDT only | NDT + RSU | improvement (ratio where NDT < 5 cm) | NDT + RSU, smoother | NDT + RSU, " << reference
+  table1 << "| site | roadside LiDAR | coverage | NDT only | NDT + RSU | improvement (ratio where NDT < " << fmt("%.0f", 100 * kNdtFallsShort)
+         << " cm) | NDT + RSU, smoother | NDT + RSU, " << reference
          << " | improvement | NDT only (all samples) | NDT + RSU (all samples) | improvement (all samples) |\n"
             "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   table1_csv << "site,lidar,range_m,trials,ndt_paper_m,ndt_paper_sd,fused_paper_m,fused_paper_sd,improvement_paper_pct,improvement_min_pct,"
@@ -649,7 +650,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   md << ". Errors are planar, against ground truth, where the vehicle is within the roadside LiDAR's coverage. "
      << "\"NDT only\" is the same drive and scans without the RSU's fixes. The paper's metric is the minimum error in each "
      << fmt("%.0f", bin) << " m of road, averaged over the road in coverage; \"all samples\" is the plain mean of the fused pose at 50 Hz. "
-     << "Spread: standard deviation over trials; the improvement's range is over trials; where NDT alone errs by less than 5 cm the improvement column gives the ratio of fused to NDT instead (a percentage of a few centimetres measures noise). "
+     << "Spread: standard deviation over trials; the improvement's range is over trials; where NDT alone errs by less than "
+     << fmt("%.0f", 100 * kNdtFallsShort) << " cm the improvement columns give the ratio of fused to NDT instead (a percentage of a few centimetres measures noise). "
      << "\"NDT + RSU\" fuses the fixes with their covariance " << toString(c.rsu_covariance) << ", the column beside it with "
      << toString(referenceCovariance(c.rsu_covariance))
      << " (published: the paper's per-LiDAR figures 0.01486 / 0.00681 as variances, as Autoware takes them; estimated: the "

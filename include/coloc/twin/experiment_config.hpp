@@ -29,7 +29,8 @@ enum class NdtCovarianceSource {
 
 struct ExperimentConfig {
   /// Scenario files, or the names of the built-in scenarios (config/scenarios/). Sites A-C are where
-  /// NDT is good (2-6 cm), site D where it falls short (a cutting: 14 cm), the paper's premise.
+  /// NDT is good (1.5-5.3 cm within coverage), site D where it falls short (a cutting: 12 cm), the
+  /// paper's premise.
   std::vector<std::string> sites = {"site_a", "site_b", "site_c", "site_d"};
   int trials = 10;
   std::vector<std::string> lidars = {"VLP-16", "VLP-32C"};  ///< roadside LiDAR models compared
