@@ -15,6 +15,7 @@
 #include "inbox.hpp"
 #include "initializer.hpp"
 #include "speed_scale.hpp"
+#include "fix_agreement.hpp"
 #include "travel_check.hpp"
 #include "mount_yaw.hpp"
 #include "yaw_rate_bias.hpp"
@@ -192,6 +193,7 @@ struct Pipeline::Impl {
   YawRateBiasEstimator yaw_rate_bias;
   MountYawEstimator mount_yaw;
   TravelCheck travel_check;
+  FixAgreement fix_agreement;
   Eigen::Isometry3d base_to_lidar = Eigen::Isometry3d::Identity();  // the configured extrinsic
   bool first_input_seen = false;
   Stamp clock = 0;
@@ -232,7 +234,8 @@ struct Pipeline::Impl {
         yaw_rate_bias(yaw_rate_bias_config),
         mount_yaw(mount_yaw_config),
         travel_check(TravelCheckConfig{options.map.has_value() ? c.pipeline.travel_check_window : 0.0, c.pipeline.travel_check_tolerance,
-                                       c.pipeline.travel_check_tolerance_per_metre}) {
+                                       c.pipeline.travel_check_tolerance_per_metre}),
+        fix_agreement(FixAgreementConfig{options.map.has_value() ? c.pipeline.fix_agreement_window : 0.0, c.pipeline.fix_agreement_tolerance}) {
     const Vector6d& e = c.ndt.source.lidar_pose;
     base_to_lidar = Eigen::Translation3d(e.head<3>()) * Eigen::Quaterniond(quaternionFromRollPitchYaw(e[3], e[4], e[5]));
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
@@ -292,6 +295,7 @@ struct Pipeline::Impl {
   // Starts (or restarts) the filter from a pose the initializer found, saying how and why.
   void start(const StartPose& start, const std::string& why) {
     travel_check.reset();  // NDT's poses before a start are another story's: no chord spans it
+    fix_agreement.reset();
     localizer.initialize(start.pose, initializer.twist());
     if (!localizer.initialized()) return;
     last_state = fusion::LocalizationState::kLocalized;
@@ -304,6 +308,7 @@ struct Pipeline::Impl {
   // A start from a pose given by hand: counted and said, and held against the map from the next scan.
   void startedByHand(const std::string& how, Stamp stamp) {
     travel_check.reset();
+    fix_agreement.reset();
     ++report.starts;
     report.started_how = how;
     check_start = true;
@@ -414,6 +419,7 @@ struct Pipeline::Impl {
   void forgetLearned() {
     speed_scale = SpeedScaleEstimator(speed_scale_config);
     travel_check.reset();
+    fix_agreement.reset();
     yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
     mount_yaw = MountYawEstimator(mount_yaw_config);
   }
@@ -512,6 +518,13 @@ struct Pipeline::Impl {
       ++report.ndt_travel_disagreements;
       report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
     }
+    // Where the roadside's fixes disagree with NDT's position, its pose is worth no more than that.
+    if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), rollPitchYaw(pose.pose.orientation)[2]);
+        off && off->squaredNorm() > 0.0) {
+      pose.covariance.topLeftCorner<2, 2>() += *off * off->transpose();
+      ++report.ndt_fix_disagreements;
+      report.ndt_fix_max_excess = std::max(report.ndt_fix_max_excess, off->norm());
+    }
     const fusion::IntegrityStatus& integrity = localizer.integrity();
     if (!feedPose(ndt_id, pose).rejected() && integrity.state != fusion::LocalizationState::kLost && !integrity.doubted) {
       speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
@@ -570,6 +583,7 @@ struct Pipeline::Impl {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
         travel_check.addSpeed(t.stamp, t.linear.x());
+        fix_agreement.addSpeed(t.stamp, t.linear.x());
       }
       if (std::isfinite(t.covariance(5, 5))) {
         yaw_rate_bias.addTwist(t.stamp, t.angular.z());
@@ -597,6 +611,7 @@ struct Pipeline::Impl {
       const rsu_client::FixVerdict v = checker->check(fix->fix, arrival);
       if (!v.accepted()) return reject(v.detail);
       const fusion::SourceId source = fix_sources.at(fix->fix.rsu_id);
+      fix_agreement.addFix(v.measurement.stamp, v.measurement.pose.position.head<2>());
       initializer.addPosition(source_names[source], v.measurement.stamp, v.measurement.pose.position.head<2>(), v.measurement.covariance(0, 0));
       if (!localizer.initialized()) tryStart();
       if (feedPose(source, v.measurement).applied()) check_start = false;  // the roadside agrees: the start is confirmed

@@ -4,18 +4,9 @@
 #include <cmath>
 #include <vector>
 
+#include "median.hpp"
+
 namespace coloc::pipeline {
-
-namespace {
-
-double median(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  if (v.size() % 2) return *mid;
-  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
-}
-
-}  // namespace
 
 TravelCheck::TravelCheck(TravelCheckConfig config)
     : config_(config), distance_(fromSeconds(3.0 * std::max(config.window, 0.0) + 1.0)) {}

@@ -80,6 +80,9 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
                 "%llu had none to compare yet\n",
                 (unsigned long long)r.pipeline_report.ndt_travel_disagreements,
                 r.pipeline_report.ndt_travel_max_excess, (unsigned long long)r.pipeline_report.ndt_travel_unverified);
+    if (r.pipeline_report.ndt_fix_disagreements > 0)
+      std::printf("  NDT's position against the roadside's fixes: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m)\n",
+                  (unsigned long long)r.pipeline_report.ndt_fix_disagreements, r.pipeline_report.ndt_fix_max_excess);
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
     std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
     std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);

@@ -131,6 +131,13 @@ struct PipelineSection {
   /// A pose with no chord to compare yet (the first window after a start) is taken at no better than
   /// this standard deviation in x and y (Autoware's fixed NDT covariance by default).
   double travel_check_unverified_sd = 0.15;        ///< m
+  /// Each NDT pose is held against the fixes of the last fix_agreement_window seconds (those that
+  /// passed the registry's checks, carried to its stamp by the odometry; pipeline/fix_agreement.hpp):
+  /// their median disagreement beyond the tolerance is added to its x/y covariance. NDT's score
+  /// vouches for NDT's own bias (a map off the world, an optimum off the truth); within an RSU's
+  /// coverage the fixes show it.
+  double fix_agreement_window = 0.0;               ///< s; 0 = off
+  double fix_agreement_tolerance = 0.03;           ///< m
 };
 
 /// The Ceres smoother of recorded logs (coloc smooth, the experiment's smoother column). Its rate,

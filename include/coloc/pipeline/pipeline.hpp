@@ -83,6 +83,10 @@ struct PipelineReport {
   std::uint64_t ndt_travel_disagreements = 0;
   double ndt_travel_max_excess = 0.0;
   std::uint64_t ndt_travel_unverified = 0;   ///< with no chord to compare yet, taken at travel_check_unverified_sd
+  /// NDT poses the roadside's fixes disagreed with beyond pipeline.fix_agreement_tolerance (their
+  /// covariance widened by the excess), and the largest excess, m.
+  std::uint64_t ndt_fix_disagreements = 0;
+  double ndt_fix_max_excess = 0.0;
   std::uint64_t rejections = 0;              ///< every refusal, of any kind
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };
