@@ -294,8 +294,7 @@ struct Pipeline::Impl {
 
   // Starts (or restarts) the filter from a pose the initializer found, saying how and why.
   void start(const StartPose& start, const std::string& why) {
-    travel_check.reset();  // NDT's poses before a start are another story's: no chord spans it
-    fix_agreement.reset();
+    resetChecks();
     localizer.initialize(start.pose, initializer.twist());
     if (!localizer.initialized()) return;
     last_state = fusion::LocalizationState::kLocalized;
@@ -307,8 +306,7 @@ struct Pipeline::Impl {
 
   // A start from a pose given by hand: counted and said, and held against the map from the next scan.
   void startedByHand(const std::string& how, Stamp stamp) {
-    travel_check.reset();
-    fix_agreement.reset();
+    resetChecks();
     ++report.starts;
     report.started_how = how;
     check_start = true;
@@ -416,10 +414,16 @@ struct Pipeline::Impl {
     if (better) check_start = false;  // degraded now, until an RSU's fix agrees
   }
 
-  void forgetLearned() {
-    speed_scale = SpeedScaleEstimator(speed_scale_config);
+  // NDT's poses before a start or a reset are another story's: no chord, and no fix's comparison,
+  // spans the jump.
+  void resetChecks() {
     travel_check.reset();
     fix_agreement.reset();
+  }
+
+  void forgetLearned() {
+    speed_scale = SpeedScaleEstimator(speed_scale_config);
+    resetChecks();
     yaw_rate_bias = YawRateBiasEstimator(yaw_rate_bias_config);
     mount_yaw = MountYawEstimator(mount_yaw_config);
   }
@@ -509,7 +513,8 @@ struct Pipeline::Impl {
     // another place, and what they would teach about the odometry is not the vehicle's.
     // Where NDT's travel disagrees with the odometry's, its pose is worth no more than the disagreement.
     // A pose with nothing to compare yet is taken at no better than the unverified figure.
-    const std::optional<Eigen::Vector2d> excess = travel_check.check(pose.stamp, pose.pose.position.head<2>(), rollPitchYaw(pose.pose.orientation)[2]);
+    const double yaw = rollPitchYaw(pose.pose.orientation)[2];
+    const std::optional<Eigen::Vector2d> excess = travel_check.check(pose.stamp, pose.pose.position.head<2>(), yaw);
     if (!excess) {
       pose.covariance.topLeftCorner<2, 2>() = atLeast(pose.covariance.topLeftCorner<2, 2>(), config.pipeline.travel_check_unverified_sd);
       ++report.ndt_travel_unverified;
@@ -519,8 +524,7 @@ struct Pipeline::Impl {
       report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
     }
     // Where the roadside's fixes disagree with NDT's position, its pose is worth no more than that.
-    if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), rollPitchYaw(pose.pose.orientation)[2]);
-        off && off->squaredNorm() > 0.0) {
+    if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), yaw); off && off->squaredNorm() > 0.0) {
       pose.covariance.topLeftCorner<2, 2>() += *off * off->transpose();
       ++report.ndt_fix_disagreements;
       report.ndt_fix_max_excess = std::max(report.ndt_fix_max_excess, off->norm());
