@@ -2,8 +2,9 @@
 # Usage: uncalibrated_start.sh COLOC SCENARIO
 # The first metres of a drive, before the odometry's speed scale and the LiDAR's mounting are learned
 # (config/scenarios/uncalibrated_start.yaml: odometry 1 % high, LiDAR turned 0.6 deg, NDT accurate):
-# using the learned scale from its first 5 m chord must beat waiting for 15 m. The fused pose against
-# NDT's own is printed: it is still over twice NDT's error there (docs/experiment.md, "The first metres").
+# with the defaults the fused pose is within 1.1x NDT's own poses over the drive (NDT's covariance from
+# its score: with Autoware's fixed matrix it was 2.7x), and using the learned scale from its first 5 m
+# chord beats waiting for 15 m (docs/experiment.md, "The first metres").
 set -euo pipefail
 coloc=$1
 scenario=$2
@@ -19,4 +20,5 @@ fused=$(mean_of "position error vs ground truth" "$work/one_chord.txt")
 waited=$(mean_of "position error vs ground truth" "$work/three_chords.txt")
 ndt=$(mean_of "ndt  .*its own poses" "$work/one_chord.txt")
 echo "fused $fused m with the scale from one chord, $waited m waiting for three; NDT's own poses $ndt m"
-awk -v a="$fused" -v b="$waited" 'BEGIN { exit !(a < 0.85 * b) }' || { echo "FAIL: one chord $fused m against three chords $waited m"; exit 1; }
+awk -v a="$fused" -v n="$ndt" 'BEGIN { exit !(a <= 1.1 * n) }' || { echo "FAIL: fused $fused m against NDT's own $ndt m (at most 1.1x)"; exit 1; }
+awk -v a="$fused" -v b="$waited" 'BEGIN { exit !(a < 0.9 * b) }' || { echo "FAIL: one chord $fused m against three chords $waited m"; exit 1; }

@@ -53,19 +53,21 @@ struct NdtConfig {
   /// resolution 2.0 and its preprocessing.
   double nvtl_threshold = 2.3;
   int max_oscillations = 10;  ///< successive steps reversing direction before the result is refused
-  /// Autoware's fixed matrix by default. `laplace` (the score's curvature at the optimum, per
-  /// direction) with the pipeline's travel check follows NDT where NDT is good (the twin's
-  /// uncalibrated start: 1.06x NDT's error against 2.74x), but trusts NDT's own bias too: a roadside
-  /// fix 2 cm from the truth no longer brings back a match 11 cm off (test HandStartInARepeatingStreet
-  /// fails with it); docs/ndt.md, "Covariance".
-  CovarianceMode covariance = CovarianceMode::kFixed;
+  /// multi_ndt_score by default, not Autoware's fixed matrix: the fixed 15 cm makes the filter follow
+  /// the odometry's error for seconds where NDT is a centimetre good (the twin's uncalibrated start:
+  /// fused 2.74x NDT's own error with `fixed`, 1.06x with this), while the score's spread along and
+  /// across the heading still says where a corridor holds nothing. What the score cannot see, NDT's
+  /// bias (a match off the truth that every scan repeats), the pipeline's travel and fix-agreement
+  /// checks widen; docs/ndt.md, "Covariance". `fixed` gives Autoware's behaviour.
+  CovarianceMode covariance = CovarianceMode::kMultiNdtScore;
   /// x, y, z, roll, pitch, yaw variances (m^2, rad^2) of the fixed covariance.
   Vector6d fixed_covariance = (Vector6d() << 0.0225, 0.0225, 0.0225, 0.000625, 0.000625, 0.000625).finished();
   /// laplace and multi_ndt_score: each variance at least this (the rotated x/y block in every
-  /// direction for multi_ndt_score). x and y at a millimetre, below any real match, so that no floor
-  /// hides a good one; z, roll, pitch and yaw at Autoware's fixed figures, which the filter's 2-D
-  /// state and its yaw-bias state were tuned with.
-  Vector6d covariance_floor = (Vector6d() << 1e-6, 1e-6, 0.0225, 0.000625, 0.000625, 0.000625).finished();
+  /// direction for multi_ndt_score). x and y at a centimetre: a real match is not better than the
+  /// map's survey, and a score-based covariance below it lets ten poses a second, each repeating the
+  /// last one's small bias, outvote a fix. z, roll, pitch and yaw at Autoware's fixed figures, which
+  /// the filter's 2-D state and its yaw-bias state were tuned with.
+  Vector6d covariance_floor = (Vector6d() << 1e-4, 1e-4, 0.0225, 0.000625, 0.000625, 0.000625).finished();
   /// multi_ndt_score: the softmax temperature on NVTL: an offset whose NVTL is this much below the
   /// optimum's weighs 1/e of it. Autoware's 0.05 makes the ground of an open road, which scores alike
   /// a metre along, outweigh the structure that holds the scan (10-50 cm along the road where NDT is

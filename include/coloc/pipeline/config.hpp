@@ -135,8 +135,9 @@ struct PipelineSection {
   /// passed the registry's checks, carried to its stamp by the odometry; pipeline/fix_agreement.hpp):
   /// their median disagreement beyond the tolerance is added to its x/y covariance. NDT's score
   /// vouches for NDT's own bias (a map off the world, an optimum off the truth); within an RSU's
-  /// coverage the fixes show it.
-  double fix_agreement_window = 0.0;               ///< s; 0 = off
+  /// coverage the fixes show it. On by default with multi_ndt_score: without it a hand start one
+  /// post off in a repeating street stays 11.5 cm off against fixes 2 cm from the truth.
+  double fix_agreement_window = 2.0;               ///< s; 0 = off
   double fix_agreement_tolerance = 0.03;           ///< m
 };
 
