@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <sstream>
 
@@ -165,8 +166,8 @@ FixVerdict FixChecker::checkSent(const RsuFix& fix, const RsuInfo& rsu, FixCount
   // The variance the RSU sent against the registry's: an RSU may say a fix is less sure than its
   // LiDAR's figure (each fix's covariance from its own fit: a far car seen on one face), never surer;
   // one that claims more is misconfigured (another LiDAR model, another placement) and its fixes are
-  // not trusted blindly. A calibrated variance is the vehicle's own measurement of this RSU and
-  // supersedes what it sends, by the registry's word.
+  // not trusted blindly. With a calibrated variance, the vehicle's own measurement of this RSU, the
+  // figure is not held against the RSU: the calibration replaces it (checkKnown).
   if (!rsu.calibrated_variance) {
     const double expected = registry_.variance(rsu);
     for (int i = 0; i < 2; ++i)
@@ -208,9 +209,23 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
   v.measurement.pose.position = {fix.x, fix.y, 0.0};
   v.measurement.covariance = Matrix6d::Zero();
   v.measurement.covariance.diagonal() << variance, variance, kInfinity, kInfinity, kInfinity, kInfinity;
-  // What the RSU sent of this fix (checked: at least the registry's figure), unless the vehicle's own
-  // calibration of this RSU supersedes it.
-  if (fix.sent && !rsu->calibrated_variance) v.measurement.covariance.topLeftCorner<2, 2>() = fix.sent->covariance.topLeftCorner<2, 2>();
+  // What the RSU sent of this fix (checked: at least the registry's figure). The vehicle's own
+  // calibration of this RSU replaces that figure, the floor an RSU raises each principal variance of
+  // its fit to; what a fix says beyond it (its own fit's doubt along a direction: a car far off, one
+  // face seen) is this fix's and stays, at least the calibrated variance.
+  if (fix.sent) {
+    const Eigen::Matrix2d sent = fix.sent->covariance.topLeftCorner<2, 2>();
+    if (!rsu->calibrated_variance) {
+      v.measurement.covariance.topLeftCorner<2, 2>() = sent;
+    } else {
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(sent);
+      const double figure = registry_.lidarVariance(*rsu) * (1.0 + 1e-6);
+      Eigen::Vector2d variances;
+      for (int i = 0; i < 2; ++i) variances[i] = eigen.eigenvalues()[i] > figure ? std::max(eigen.eigenvalues()[i], variance) : variance;
+      const Eigen::Matrix2d c = eigen.eigenvectors() * variances.asDiagonal() * eigen.eigenvectors().transpose();
+      v.measurement.covariance.topLeftCorner<2, 2>() = 0.5 * (c + c.transpose());
+    }
+  }
   return v;
 }
 

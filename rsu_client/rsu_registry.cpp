@@ -179,8 +179,9 @@ const RsuInfo* RsuRegistry::find(const std::string& id) const {
   return nullptr;
 }
 
-double RsuRegistry::variance(const RsuInfo& rsu) const {
-  if (rsu.calibrated_variance) return *rsu.calibrated_variance;
+double RsuRegistry::variance(const RsuInfo& rsu) const { return rsu.calibrated_variance ? *rsu.calibrated_variance : lidarVariance(rsu); }
+
+double RsuRegistry::lidarVariance(const RsuInfo& rsu) const {
   return placement_ == CovariancePlacement::kPublished ? rsu.lidar.sigma : rsu.lidar.sigma * rsu.lidar.sigma;
 }
 

@@ -110,14 +110,9 @@ void printCounters(const roadside::RsuStation& station) {
 }
 
 // A fix as sent: addressed to its vehicle, with the covariance of its own fit, never below the
-// registry's figure for this RSU's LiDAR (what a vehicle refuses): raised evenly where it would be.
+// registry's figure for this RSU's LiDAR (what a vehicle refuses).
 io::Bytes fixMessage(Stamp stamp, const roadside::StationOutcome& o, double floor) {
-  io::Odometry m = twin::addressedFix(stamp, o.detection.position, floor, o.station_id);
-  Eigen::Matrix2d c = o.detection.covariance;
-  const double lowest = std::min(c(0, 0), c(1, 1));
-  if (!(lowest >= floor)) c.diagonal().array() += floor - (std::isfinite(lowest) ? lowest : 0.0);
-  if (c.allFinite()) m.pose.covariance.topLeftCorner<2, 2>() = 0.5 * (c + c.transpose());
-  return io::encodeOdometry(m);
+  return io::encodeOdometry(twin::addressedFix(stamp, o.detection.position, o.detection.covariance, floor, o.station_id));
 }
 
 // The frame's points, in its sensor frame.

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <Eigen/Eigenvalues>
 
 #include "coloc/core/error.hpp"
 #include "coloc/io/bag_writer.hpp"
@@ -314,6 +315,18 @@ io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, double v
   return fix;
 }
 
+io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance, double floor, std::uint32_t station_id) {
+  io::Odometry fix = addressedFix(stamp, position, floor, station_id);
+  if (!covariance.allFinite()) return fix;
+  // Each principal variance at least the floor: what the fit says beyond it survives as said (a
+  // receiver that has calibrated this RSU replaces the floor alone: rsu_client/rsu_fix.cpp).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(0.5 * (covariance + covariance.transpose()));
+  const Eigen::Vector2d variances = eigen.eigenvalues().cwiseMax(floor);
+  const Eigen::Matrix2d c = eigen.eigenvectors() * variances.asDiagonal() * eigen.eigenvectors().transpose();
+  fix.pose.covariance.topLeftCorner<2, 2>() = 0.5 * (c + c.transpose());
+  return fix;
+}
+
 TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordingOptions& options) {
   const auto wall_start = Clock::now();
   const std::string& out_dir = options.out_dir;
@@ -586,8 +599,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         if (!sent) continue;
         const Eigen::Vector2d local = Eigen::Rotation2Dd(r.info.yaw).inverse() * (od.position - r.info.position);
         const Eigen::Vector2d reported = r.info.position + r.info.survey_error.head<2>() + Eigen::Rotation2Dd(r.info.yaw + r.info.survey_error.z()) * local;
+        const Eigen::Matrix2d turn = Eigen::Rotation2Dd(r.info.survey_error.z()).toRotationMatrix();
         bag.write(rsu_client::addressedFixTopic(r.info.id), *sent,
-                  io::encodeOdometry(addressedFix(at(capture) + fromSeconds(r.info.clock_offset), reported, r.variance, *other.station_id)));
+                  io::encodeOdometry(addressedFix(at(capture) + fromSeconds(r.info.clock_offset), reported, turn * od.covariance * turn.transpose(), r.variance,
+                                                  *other.station_id)));
         ++summary.connected_fixes;
       }
       // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
@@ -649,6 +664,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       const Eigen::Rotation2Dd true_yaw(r.info.yaw), surveyed_yaw(r.info.yaw + r.info.survey_error.z());
       const Eigen::Vector2d local = true_yaw.inverse() * (d.position - r.info.position);
       d.position = r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * local;
+      // The fit's covariance, as the RSU reports it: turned with the position (a survey error in yaw).
+      const Eigen::Matrix2d turn = (surveyed_yaw * true_yaw.inverse()).toRotationMatrix();
+      const Eigen::Matrix2d sent_covariance = turn * d.covariance * turn.transpose();
       const Eigen::Vector2d error = d.position - seen.position;
       // Stamped on the RSU's clock, with its per-frame stamp error; where the vehicle was at that stamp.
       const double jitter = errors.clock_jitter_sd > 0.0 ? errors.clock_jitter_sd * stamp_jitter(stamp_rng) : 0.0;
@@ -677,13 +695,13 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         continue;
       }
       bag.write(rsu_client::addressedFixTopic(r.info.id), *delivered,
-                io::encodeOdometry(addressedFix(at(capture) + fromSeconds(stamp_offset), d.position, r.variance, scenario.vehicle_station_id)));
+                io::encodeOdometry(addressedFix(at(capture) + fromSeconds(stamp_offset), d.position, sent_covariance, r.variance, scenario.vehicle_station_id)));
       ++summary.fixes;
       if (options.perfect_rsus) {
         // Through the true pose, as the same expression computes it with a survey error of zero.
         const Eigen::Vector2d perfect = r.info.position + true_yaw * local;
         bag.write(rsu_client::addressedFixTopic(perfectRsuId(r.info.id)), *delivered,
-                  io::encodeOdometry(addressedFix(at(capture) + fromSeconds(jitter), perfect, r.variance, scenario.vehicle_station_id)));
+                  io::encodeOdometry(addressedFix(at(capture) + fromSeconds(jitter), perfect, d.covariance, r.variance, scenario.vehicle_station_id)));
       }
     }
   }

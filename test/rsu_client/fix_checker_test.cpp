@@ -208,10 +208,58 @@ TEST(FixChecker, ARegistryFrameOtherThanMapAndACalibratedVarianceAreHonoured) {
   EXPECT_EQ(c.check(fix, kNow).rejection, FixRejection::kWrongFrame);
   fix.sent->frame_id = "earth";
   fix.stamp -= 1;
-  // The vehicle's own measurement of this RSU supersedes the variance the RSU sends.
+  // The vehicle's own measurement of this RSU replaces the LiDAR's figure the RSU sends.
   const FixVerdict v = c.check(fix, kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_EQ(v.measurement.covariance(0, 0), 0.0004);
+}
+
+// A calibration replaces the LiDAR's figure, the floor an RSU raises each principal variance of its fit
+// to, not what a fix says beyond it: a far car's fit sent as less sure than the figure keeps its own
+// covariance, each principal variance at least the calibrated one.
+TEST(FixChecker, ACalibratedRsusFixKeepsWhatItSaysBeyondItsLidarsFigure) {
+  FixCheckConfig one_vehicle;
+  one_vehicle.accept_unaddressed = true;
+  FixChecker published(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n", "test"),
+                       one_vehicle);
+  RsuFix at_figure = sentFix(kNow - 1000, 101);  // sent with the figure, 0.01486
+  FixVerdict v = published.check(at_figure, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.0004, 1e-15);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.0004, 1e-15);
+  EXPECT_NEAR(v.measurement.covariance(0, 1), 0.0, 1e-15);
+  // Principal variances 0.0441 and 0.0159, both beyond the figure: kept as sent.
+  RsuFix far = sentFix(kNow - 900, 101);
+  far.sent->covariance(0, 0) = 0.04;
+  far.sent->covariance(1, 1) = 0.02;
+  far.sent->covariance(0, 1) = far.sent->covariance(1, 0) = 0.01;
+  v = published.check(far, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.04, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.02, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(0, 1), 0.01, 1e-12);
+  // Only one direction beyond the figure (an RSU raised the other to it): that one kept, the other
+  // the calibration's.
+  RsuFix one_face = sentFix(kNow - 850, 101);
+  one_face.sent->covariance(0, 0) = 0.03;
+  v = published.check(one_face, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.03, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.0004, 1e-12);
+  // In metres (figure 0.01486^2 = 0.000221) with a calibration of 10 cm: a fit of 20 / 1.7 cm keeps
+  // its 20 cm, and the 1.7 cm, below the calibration, takes the calibration's 10.
+  FixChecker metres(RsuRegistry::parse("covariance_placement: standard_deviation\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, "
+                                       "calibrated_variance: 0.01}\n",
+                                       "test"),
+                    one_vehicle);
+  RsuFix fit = sentFix(kNow - 800, 101);
+  fit.sent->covariance(0, 0) = 0.04;
+  fit.sent->covariance(1, 1) = 0.0003;
+  v = metres.check(fit, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.04, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.01, 1e-12);
+  EXPECT_TRUE(std::isinf(v.measurement.covariance(2, 2)));
 }
 
 TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {

@@ -60,7 +60,7 @@ struct RoadsidePerceptionConfig {
   /// worse than 13.3 cm). Seen square on, from a gantry over the lane, either end may be the lost one,
   /// and `max_face_shortfall` holds. Side faces keep it too: taken obliquely up to 0.6 m short, they
   /// gave the 2 m masts of the experiment fixes that made the fused error worse (site B's VLP-32C 0.42
-  /// -> 0.50 cm) while the twin's RSUs send the registry's figure rather than each fix's covariance.
+  /// -> 0.50 cm) while the twin's RSUs sent the registry's figure rather than each fix's covariance.
   double max_width_face_shortfall = 0.6;  ///< m
   double oblique_face = 5.0 * M_PI / 180.0;  ///< rad
   /// Returns the fit needs (with `attribute`): a car 60 m from a 2 m mast showed a 64-beam LiDAR 4 on

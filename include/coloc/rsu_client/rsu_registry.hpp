@@ -76,6 +76,8 @@ class RsuRegistry {
   /// The x/y variance a fix from this RSU carries: its calibrated variance, else the model's figure
   /// placed as the registry says.
   double variance(const RsuInfo& rsu) const;
+  /// The model's figure alone, placed as the registry says: the least an RSU of this LiDAR may send.
+  double lidarVariance(const RsuInfo& rsu) const;
 
  private:
   std::vector<RsuInfo> rsus_;

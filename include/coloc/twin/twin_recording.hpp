@@ -73,6 +73,11 @@ std::string perfectRsuId(const std::string& id);
 /// A roadside fix as an RSU sends it under the protocol (docs/rsu-protocol.md): addressed to
 /// the vehicle of `station_id`, the RSU's variance on x and y, not measured elsewhere.
 io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, double variance, std::uint32_t station_id);
+/// The same with the covariance of the fix's own fit (map frame, m^2; roadside/fix_covariance.hpp),
+/// never below `floor`, the registry's figure for the RSU's LiDAR (what a vehicle refuses as surer
+/// than that), in any direction: each principal variance raised to it where below. A covariance that
+/// is not finite sends the floor.
+io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance, double floor, std::uint32_t station_id);
 
 /// One RSU frame within coverage: what the perception made of it.
 struct RsuFrameRecord {
