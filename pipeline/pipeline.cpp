@@ -15,6 +15,7 @@
 #include "inbox.hpp"
 #include "initializer.hpp"
 #include "speed_scale.hpp"
+#include "cam_size_correction.hpp"
 #include "fix_agreement.hpp"
 #include "travel_check.hpp"
 #include "mount_yaw.hpp"
@@ -194,6 +195,7 @@ struct Pipeline::Impl {
   MountYawEstimator mount_yaw;
   TravelCheck travel_check;
   FixAgreement fix_agreement;
+  CamSizeCorrection cam_size;
   Eigen::Isometry3d base_to_lidar = Eigen::Isometry3d::Identity();  // the configured extrinsic
   bool first_input_seen = false;
   Stamp clock = 0;
@@ -235,7 +237,8 @@ struct Pipeline::Impl {
         mount_yaw(mount_yaw_config),
         travel_check(TravelCheckConfig{options.map.has_value() ? c.pipeline.travel_check_window : 0.0, c.pipeline.travel_check_tolerance,
                                        c.pipeline.travel_check_tolerance_per_metre}),
-        fix_agreement(FixAgreementConfig{options.map.has_value() ? c.pipeline.fix_agreement_window : 0.0, c.pipeline.fix_agreement_tolerance}) {
+        fix_agreement(FixAgreementConfig{options.map.has_value() ? c.pipeline.fix_agreement_window : 0.0, c.pipeline.fix_agreement_tolerance}),
+        cam_size{c.rsu.vehicle_length, c.rsu.vehicle_width, c.rsu.cam_size_step} {
     const Vector6d& e = c.ndt.source.lidar_pose;
     base_to_lidar = Eigen::Translation3d(e.head<3>()) * Eigen::Quaterniond(quaternionFromRollPitchYaw(e[3], e[4], e[5]));
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
@@ -612,8 +615,14 @@ struct Pipeline::Impl {
         return reject("fix from '" + fix->fix.rsu_id + "' stamped " + formatSeconds(fix->fix.stamp) +
                       " rejected (unknown_rsu): no RSU registry is configured");
       }
-      const rsu_client::FixVerdict v = checker->check(fix->fix, arrival);
+      rsu_client::FixVerdict v = checker->check(fix->fix, arrival);
       if (!v.accepted()) return reject(v.detail);
+      // The CAM's rounding of this vehicle's size, taken back where the heading is known.
+      if (cam_size.enabled() && localizer.initialized())
+        if (const rsu_client::RsuInfo* rsu = checker->registry().find(fix->fix.rsu_id)) {
+          const double heading = rollPitchYaw(localizer.estimate()->pose.orientation)[2];
+          v.measurement.pose.position.head<2>() = cam_size.apply(v.measurement.pose.position.head<2>(), rsu->position, heading);
+        }
       const fusion::SourceId source = fix_sources.at(fix->fix.rsu_id);
       fix_agreement.addFix(v.measurement.stamp, v.measurement.pose.position.head<2>());
       initializer.addPosition(source_names[source], v.measurement.stamp, v.measurement.pose.position.head<2>(), v.measurement.covariance(0, 0));

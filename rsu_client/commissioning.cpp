@@ -108,6 +108,15 @@ CommissioningResult fit(const Eigen::Vector2d& at, const std::vector<Commissioni
 
 }  // namespace
 
+std::vector<Eigen::Vector2d> commissioningResiduals(const Eigen::Vector2d& at, const std::vector<CommissioningSample>& samples,
+                                                    const RsuCalibrationEntry& calibration) {
+  const Eigen::Vector4d p(calibration.dx, calibration.dy, calibration.dyaw, calibration.clock_offset);
+  std::vector<Eigen::Vector2d> out;
+  for (const CommissioningSample& sample : samples)
+    if (sample.fix.allFinite() && sample.reference.allFinite() && sample.velocity.allFinite()) out.push_back(residual(at, sample, p, nullptr));
+  return out;
+}
+
 CommissioningResult commissionRsu(const Eigen::Vector2d& at, const std::vector<CommissioningSample>& all, const CommissioningConfig& config) {
   // A sample with a NaN or infinite value says nothing; it is counted, not fitted.
   std::vector<CommissioningSample> samples;

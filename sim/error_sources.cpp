@@ -16,6 +16,7 @@ ErrorSources ErrorSources::ideal() {
   e.lidar_mount_yaw = 0.0;
   e.map_position_sd = 0.0;
   e.map_yaw_sd = 0.0;
+  e.cam_size_step = 0.0;
   return e;
 }
 

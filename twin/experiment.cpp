@@ -481,6 +481,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     // where the LiDAR is, only where its fixes are said to be, and when).
     r.options.perfect_rsus = drive.variant == kNextDrive;
     r.options.oracle_fix_limit = config.oracle_fix_limit;
+    // The noise calibration drive is the commissioning pass: its vehicle is the operator's probe, whose
+    // size is entered as measured, not as a CAM rounds it; the variance of its fixes as sent is the
+    // operating vehicles'.
+    r.options.probe_size_for_commissioning = drive.variant == kNoiseCalibrationDrive;
     r.summary = recordTwin(r.scenario, r.options);
     r.seconds = since(t0);
     return r;
@@ -543,6 +547,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     // The map's survey accuracy, as coloc simulate writes it into fuse.yaml: reported, never filtered
     // (the sites' replays had 0.3-13 % of their localized ticks beyond 3 sd without it, none with it).
     if (fuse.fusion.map_error_sd == 0.0) fuse.fusion.map_error_sd = scenario.errors.map_position_sd;
+    // The car knows its own size and what its CAM rounds it to, as coloc simulate writes them.
+    if (scenario.errors.cam_size_step > 0.0 && fuse.rsu.vehicle_length == 0.0) {
+      fuse.rsu.vehicle_length = summary.ego_length;
+      fuse.rsu.vehicle_width = summary.ego_width;
+      fuse.rsu.cam_size_step = scenario.errors.cam_size_step;
+    }
     std::vector<Eigen::Vector2d> rsu_positions;
     for (const sim::ScenarioRsu& r : scenario.rsus) rsu_positions.push_back(r.position);
     // The drive's replays read its log once, and each NDT target of the site is built once (the same
@@ -647,9 +657,13 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           // Commissioning against the reference vehicle: its fixes matched by stamp to where the
           // vehicle was; the evaluated drives then use the calibration, and the fixes' variance is
           // measured as the calibrated registry passes them on.
-          const auto found = summary.fix_samples.find(r.id);
-          const std::vector<rsu_client::CommissioningSample> samples =
-              found == summary.fix_samples.end() ? std::vector<rsu_client::CommissioningSample>{} : found->second;
+          const auto samplesOf = [&](const std::map<std::string, std::vector<rsu_client::CommissioningSample>>& all) {
+            const auto found = all.find(r.id);
+            return found == all.end() ? std::vector<rsu_client::CommissioningSample>{} : found->second;
+          };
+          const std::vector<rsu_client::CommissioningSample> sent = samplesOf(summary.fix_samples), probe = samplesOf(summary.probe_fix_samples);
+          // The probe's own size where its CAM would round it; the survey is then not the rounding's.
+          const std::vector<rsu_client::CommissioningSample>& samples = probe.empty() ? sent : probe;
           const rsu_client::RsuInfo entry = registryEntry(r);
           Commissioning c;
           c.site = scenario.name;
@@ -662,9 +676,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           rsu_client::RsuInfo calibrated = entry;
           calibrated.calibration = c.found.calibration;
           commissioned[{drive.site, r.id}] = calibrated;
-          // The fixes' variance as the filter will see them: calibrated, against where the vehicle was at
-          // their (corrected) stamps.
-          if (const auto v = meanSquareFixVariance(c.found.residuals)) {
+          // The fixes' variance as the filter will see them: as sent, calibrated, against where the vehicle
+          // was at their (corrected) stamps.
+          if (const auto v = meanSquareFixVariance(probe.empty() ? c.found.residuals
+                                                                 : rsu_client::commissioningResiduals(entry.position, sent, c.found.calibration))) {
             measured_variance[drive.site][r.id] = *v;
             results.estimated_variance[reportKey(scenario, r)] = *v;
           }

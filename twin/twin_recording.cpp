@@ -679,8 +679,17 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         continue;
       }
       summary.fix_errors[r.info.id].push_back(error);
-      summary.fix_samples[r.info.id].push_back(
-          {d.position, at_stamp.position, at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw))});
+      const Eigen::Vector2d velocity_then = at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw));
+      summary.fix_samples[r.info.id].push_back({d.position, at_stamp.position, velocity_then});
+      // A probe whose size the operator enters: the same frame fitted with the body's own size, the
+      // survey then not taking the CAM's rounding.
+      if (options.probe_size_for_commissioning && (camSize(body.length) != body.length || camSize(body.width) != body.width)) {
+        const roadside::VehicleDetection probe = r.perception[0].detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
+        if (probe.found)
+          summary.probe_fix_samples[r.info.id].push_back(
+              {r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * (true_yaw.inverse() * (probe.position - r.info.position)),
+               at_stamp.position, velocity_then});
+      }
       record.error = error.norm();
       keep(record);
       fixes_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << "," << error.x() << ","
@@ -743,6 +752,12 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
        << "pipeline:\n  initial_pose: [" << scenario.route_start.x() << ", " << scenario.route_start.y() << ", 0.0, " << scenario.route_heading
        << "]\nndt:\n  lidar_pose: [0.0, 0.0, " << scenario.vehicle_lidar_height << ", 0.0, 0.0, 0.0]\n"
        << "rsu:\n  registry: rsu.yaml\n  station_id: " << scenario.vehicle_station_id << "  # the ego's: its fixes are addressed to it\n";
+  // The car knows its own size and what its CAM rounds it to.
+  if (errors.cam_size_step > 0.0)
+    fuse << "  vehicle_length: " << body.length << "  # the ego's own size; its CAM sends it in steps of " << errors.cam_size_step << " m\n"
+         << "  vehicle_width: " << body.width << "\n  cam_size_step: " << errors.cam_size_step << "\n";
+  summary.ego_length = body.length;
+  summary.ego_width = body.width;
   // The map was surveyed to this (errors.map_position_sd): the reported covariance carries it, as a
   // user gives their map's survey accuracy.
   if (errors.map_position_sd > 0.0) fuse << "fusion:\n  map_error_sd: " << errors.map_position_sd << "  # the survey map's error per axis (errors.map_position_sd)\n";

@@ -79,6 +79,12 @@ struct RsuSection {
   /// need not be, and applied whole its information is in the estimate four ticks sooner. On the twin
   /// that changed nothing beyond the trials' spread (docs/experiment.md, *Network*), so fixes stay as Autoware's poses.
   int smoothing_steps = 0;
+  /// This vehicle's own length and width (m): each fix addressed to it is moved back by half what its
+  /// CAM's rounding of them to cam_size_step (ETSI: 0.1 m) made the RSU place its box off, on the side
+  /// and end the RSU sees (pipeline/cam_size_correction.hpp). 0: fixes taken as sent.
+  double vehicle_length = 0.0;
+  double vehicle_width = 0.0;
+  double cam_size_step = 0.1;  ///< m
 };
 
 struct PipelineSection {

@@ -45,4 +45,10 @@ struct CommissioningConfig {
 CommissioningResult commissionRsu(const Eigen::Vector2d& registry_position, const std::vector<CommissioningSample>& samples,
                                   const CommissioningConfig& config = {});
 
+/// Each sample's residual under a calibration (the corrected fix minus the reference at its corrected
+/// stamp), as CommissioningResult::residuals has them for the samples it was fitted on: for fixes it
+/// was not fitted on (a probe of entered size commissioned the RSU; these are what it sends others).
+std::vector<Eigen::Vector2d> commissioningResiduals(const Eigen::Vector2d& registry_position, const std::vector<CommissioningSample>& samples,
+                                                    const RsuCalibrationEntry& calibration);
+
 }  // namespace coloc::rsu_client

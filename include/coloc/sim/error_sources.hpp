@@ -40,10 +40,10 @@ struct ErrorSources {
   /// straight on. 0.3 deg: KITTI's HDL-64E against its reference trajectory shows 0.2-0.6 deg between
   /// the LiDAR's axis and the direction of travel after the published calibration.
   double lidar_mount_yaw = 0.3 * 3.14159265358979323846 / 180.0;  ///< rad
-  /// The size a vehicle's CAM tells the RSU, rounded to this step (a CAM carries length and width in
-  /// units of 0.1 m): the body then differs from the box the perception places by up to half a step.
-  /// 0: the exact body size (the experiment's sites, as the paper's CAM); `config/scenarios/poles.yaml`: 0.1.
-  double cam_size_step = 0.0;  ///< m
+  /// The size a vehicle's CAM tells the RSU, rounded to this step (ETSI's CAM carries length and width
+  /// in units of 0.1 m): the body then differs from the box the perception places by up to half a
+  /// step (the twin's car, 4.88 x 1.84 m, is sent as 4.9 x 1.8). 0: the exact body size (the ideal twin).
+  double cam_size_step = 0.1;  ///< m
 
   /// The ideal twin: perfect surveys (RSU and map), clocks and LiDAR mounting, box-shaped car, 2 cm range noise, no dropouts.
   static ErrorSources ideal();

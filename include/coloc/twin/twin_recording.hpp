@@ -65,6 +65,10 @@ struct TwinRecordingOptions {
   /// /rsu/<id>/points, in its sensor frame, and every connected vehicle's CAM on /v2x/cam (10 Hz, the
   /// vehicle's own 0.3 m error, its size in 0.1 m steps). Several MB per second of drive per RSU.
   bool record_rsu_frames = false;
+  /// Also commissioning samples (TwinRecordingSummary::probe_fix_samples) from each frame fitted with
+  /// the vehicle's own size instead of the size its CAM rounds (errors.cam_size_step): a commissioning
+  /// probe whose size the operator enters to the millimetre. The fixes sent are unchanged.
+  bool probe_size_for_commissioning = false;
 };
 
 /// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.
@@ -107,6 +111,10 @@ struct TwinRecordingSummary {
   /// vehicle's true position and velocity at the fix's stamp: what commissioning the RSU against a
   /// reference vehicle's RTK/INS log takes.
   std::map<std::string, std::vector<rsu_client::CommissioningSample>> fix_samples;
+  /// The same with the vehicle's own size instead of its CAM's (TwinRecordingOptions::probe_size_for_commissioning);
+  /// empty where the two sizes are equal.
+  std::map<std::string, std::vector<rsu_client::CommissioningSample>> probe_fix_samples;
+  double ego_length = 0.0, ego_width = 0.0;  ///< m, the ego's body, which its CAM sends rounded (errors.cam_size_step)
   /// The vehicle's true position at every ground-truth sample the log has (100 Hz).
   std::vector<std::pair<Stamp, Eigen::Vector2d>> truth;
   /// Each odometry sample: (measured speed, true speed, measured yaw rate, true yaw rate).

@@ -1,0 +1,23 @@
+#include "cam_size_correction.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace coloc::pipeline {
+
+double CamSizeCorrection::sent(double size) const { return std::max(step, std::round(size / step) * step); }
+
+Eigen::Vector2d CamSizeCorrection::apply(const Eigen::Vector2d& fix, const Eigen::Vector2d& rsu, double yaw) const {
+  if (!enabled() || !fix.allFinite() || !rsu.allFinite() || !std::isfinite(yaw)) return fix;
+  const Eigen::Rotation2Dd body(yaw);
+  // The RSU in the body's frame: ahead (+x) shows the front, on the left (+y) the left side.
+  const Eigen::Vector2d seen_from = body.inverse() * (rsu - fix);
+  const double along = std::abs(seen_from.x()) > 0.5 * length ? (seen_from.x() > 0.0 ? 1.0 : -1.0) : 0.0;
+  const double across = seen_from.y() > 0.0 ? 1.0 : -1.0;
+  // The box's centre is half the CAM's size from the face seen; the body's is half its own.
+  const Eigen::Vector2d shift(along * 0.5 * (sent(length) - length), across * 0.5 * (sent(width) - width));
+  return fix + body * shift;
+}
+
+}  // namespace coloc::pipeline
