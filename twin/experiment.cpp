@@ -671,15 +671,30 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           c.rsu = siteRsuId(r);
           c.dx = r.survey_error.x(), c.dy = r.survey_error.y(), c.dyaw = r.survey_error.z(), c.clock_offset = r.clock_offset;
           c.found = rsu_client::commissionRsu(entry.position, samples);
+          // The fixes as sent, calibrated, against where the vehicle was at their (corrected) stamps.
+          const std::vector<Eigen::Vector2d> residuals =
+              probe.empty() ? c.found.residuals : rsu_client::commissioningResiduals(entry.position, sent, c.found.calibration);
+          // Each against its own fit's covariance: is what a fix says of itself honest?
+          if (const auto fc = summary.fix_covariances.find(r.id);
+              c.found.determined && fc != summary.fix_covariances.end() && fc->second.size() == residuals.size()) {
+            double sum = 0.0;
+            for (std::size_t i = 0; i < residuals.size(); ++i) {
+              const Eigen::Matrix2d& C = fc->second[i];
+              if (!C.allFinite() || !residuals[i].allFinite() || C.determinant() <= 0.0) continue;
+              const double d2 = residuals[i].dot(C.ldlt().solve(residuals[i]));
+              sum += d2;
+              ++c.fixes;
+              c.beyond_3sd += d2 > 9.0 ? 1 : 0;
+            }
+            c.mean_nes = c.fixes ? sum / static_cast<double>(c.fixes) : 0.0;
+          }
           results.commissioning.push_back(c);
           if (!c.found.determined) continue;
           rsu_client::RsuInfo calibrated = entry;
           calibrated.calibration = c.found.calibration;
           commissioned[{drive.site, r.id}] = calibrated;
-          // The fixes' variance as the filter will see them: as sent, calibrated, against where the vehicle
-          // was at their (corrected) stamps.
-          if (const auto v = meanSquareFixVariance(probe.empty() ? c.found.residuals
-                                                                 : rsu_client::commissioningResiduals(entry.position, sent, c.found.calibration))) {
+          // The fixes' variance as the filter will see them.
+          if (const auto v = meanSquareFixVariance(residuals)) {
             measured_variance[drive.site][r.id] = *v;
             results.estimated_variance[reportKey(scenario, r)] = *v;
           }

@@ -334,8 +334,11 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     const double deg = 180.0 / M_PI;
     sources_md << "\nEach RSU's survey and clock error as drawn from the error sources, and as commissioning against the reference "
                   "vehicle on the noise calibration drive found it (`rsu_client/commissioning`: fixes matched by stamp to the "
-                  "reference trajectory); the evaluated drives use the calibration when it is determined:\n\n"
-               << "| site | roadside LiDAR | drawn (dx, dy, dyaw, clock) | found (± sd) | fixes used / left out | residual sd |\n|---|---|---|---|---|---|\n";
+                  "reference trajectory); the evaluated drives use the calibration when it is determined. The last two columns hold "
+                  "the fixes as sent, calibrated, against the covariance of their own fit (`roadside/fix_covariance`): the mean "
+                  "normalized squared error (2 if honest) and the fixes beyond three standard deviations (1.1 % if honest):\n\n"
+               << "| site | roadside LiDAR | drawn (dx, dy, dyaw, clock) | found (± sd) | fixes used / left out | residual sd | fixes' NES | beyond 3 sd |\n"
+                  "|---|---|---|---|---|---|---|---|\n";
     for (const Commissioning& cr : results.commissioning) {
       const rsu_client::CommissioningResult& f = cr.found;
       char drawn[128], found[224];
@@ -348,7 +351,10 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         std::snprintf(found, sizeof found, "%.3f ± %.3f m, %.3f ± %.3f m, %.3f ± %.3f deg, %s%s", f.calibration.dx, f.sd[0], f.calibration.dy, f.sd[1],
                       f.calibration.dyaw * deg, f.sd[2] * deg, clock.c_str(), f.determined ? "" : (" (not used: " + f.note + ")").c_str());
       sources_md << "| " << cr.site << " | " << withRsu(cr.site, cr.lidar, cr.rsu) << " | " << drawn << " | " << found << " | " << f.inliers << " / " << f.outliers << " | "
-                 << fmt("%.1f cm", 100 * f.residual_sd) << " |\n";
+                 << fmt("%.1f cm", 100 * f.residual_sd) << " | " << (cr.fixes ? fmt("%.2f", cr.mean_nes) : std::string("-")) << " | "
+                 << (cr.fixes ? std::to_string(cr.beyond_3sd) + " of " + std::to_string(cr.fixes) + fmt(" (%.1f %%)", 100.0 * cr.beyond_3sd / cr.fixes)
+                              : std::string("-"))
+                 << " |\n";
     }
   }
 

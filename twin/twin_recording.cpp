@@ -681,6 +681,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       summary.fix_errors[r.info.id].push_back(error);
       const Eigen::Vector2d velocity_then = at_stamp.speed * Eigen::Vector2d(std::cos(at_stamp.yaw), std::sin(at_stamp.yaw));
       summary.fix_samples[r.info.id].push_back({d.position, at_stamp.position, velocity_then});
+      summary.fix_covariances[r.info.id].push_back(sent_covariance);
       // A probe whose size the operator enters: the same frame fitted with the body's own size, the
       // survey then not taking the CAM's rounding.
       if (options.probe_size_for_commissioning && (camSize(body.length) != body.length || camSize(body.width) != body.width)) {

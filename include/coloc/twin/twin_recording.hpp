@@ -114,6 +114,9 @@ struct TwinRecordingSummary {
   /// The same with the vehicle's own size instead of its CAM's (TwinRecordingOptions::probe_size_for_commissioning);
   /// empty where the two sizes are equal.
   std::map<std::string, std::vector<rsu_client::CommissioningSample>> probe_fix_samples;
+  /// Per RSU id: each fix_samples entry's covariance from its own fit, as the RSU reports it (map
+  /// frame, m^2; before the floor of the LiDAR's figure): what the fix says of itself.
+  std::map<std::string, std::vector<Eigen::Matrix2d>> fix_covariances;
   double ego_length = 0.0, ego_width = 0.0;  ///< m, the ego's body, which its CAM sends rounded (errors.cam_size_step)
   /// The vehicle's true position at every ground-truth sample the log has (100 Hz).
   std::vector<std::pair<Stamp, Eigen::Vector2d>> truth;
