@@ -8,15 +8,36 @@
 
 namespace coloc::pipeline {
 
-TravelCheck::TravelCheck(TravelCheckConfig config)
-    : config_(config), distance_(fromSeconds(3.0 * std::max(config.window, 0.0) + 1.0)) {}
+namespace {
+
+constexpr std::size_t kIntervals = 9;  // the poses' interval as the median of the last few
+
+// The odometry kept: three of the longest window, and a second to spare.
+Duration spanOf(const TravelCheckConfig& c) { return fromSeconds(3.0 * std::max({c.window, c.max_window, 0.0}) + 1.0); }
+
+}  // namespace
+
+TravelCheck::TravelCheck(TravelCheckConfig config) : config_(config), distance_(spanOf(config)) {}
+
+Duration TravelCheck::window() const {
+  const Duration configured = fromSeconds(config_.window);
+  // Three intervals before the pace is believed; their lower median, so that one gap (a scan lost, a
+  // stretch NDT refused) does not stretch the window.
+  if (intervals_.size() < 3) return configured;
+  std::vector<Duration> sorted(intervals_.begin(), intervals_.end());
+  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>((sorted.size() - 1) / 2);
+  std::nth_element(sorted.begin(), mid, sorted.end());
+  const Duration two = 2 * *mid;
+  return std::max(configured, std::min(two, fromSeconds(std::max(config_.max_window, config_.window))));
+}
 
 void TravelCheck::addSpeed(Stamp stamp, double speed) {
   if (config_.window > 0.0) distance_.add(stamp, speed);
 }
 
 void TravelCheck::reset() {
-  distance_ = OdometryIntegral(fromSeconds(3.0 * std::max(config_.window, 0.0) + 1.0));
+  distance_ = OdometryIntegral(spanOf(config_));
+  intervals_.clear();
   poses_.clear();
 }
 
@@ -25,7 +46,11 @@ std::optional<Eigen::Vector2d> TravelCheck::check(Stamp stamp, const Eigen::Vect
   if (!position.allFinite() || !std::isfinite(yaw)) return std::nullopt;
   // Poses out of order (a late scan) are neither compared nor kept: chords run forward in time.
   if (!poses_.empty() && stamp <= poses_.back().stamp) return std::nullopt;
-  const Stamp window = fromSeconds(config_.window);
+  if (!poses_.empty()) {
+    intervals_.push_back(stamp - poses_.back().stamp);
+    if (intervals_.size() > kIntervals) intervals_.pop_front();
+  }
+  const Duration window = this->window();
   while (!poses_.empty() && poses_.front().stamp < stamp - 2 * window) poses_.pop_front();
   // Every kept pose one to two windows old starts a chord; the median of their disagreements is
   // NDT's: a single bad match at either end of a chord does not make the other look bad.

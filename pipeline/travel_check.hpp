@@ -24,6 +24,8 @@ struct TravelCheckConfig {
   double window = 0.5;           ///< s: chords start at poses one to two windows old; 0 = off
   double tolerance = 0.03;       ///< m of disagreement NDT's and the odometry's noise explain
   double tolerance_per_metre = 0.005;  ///< and this much per metre of travel (the speed scale as learned)
+  /// s: the longest window the check widens to for a slow pose stream (see TravelCheck::window).
+  double max_window = 5.0;
 };
 
 class TravelCheck {
@@ -37,6 +39,11 @@ class TravelCheck {
   /// two poses one to two windows old, no odometry) or the pose is not finite. The pose is kept as later chords' start.
   std::optional<Eigen::Vector2d> check(Stamp stamp, const Eigen::Vector2d& position, double yaw);
   void reset();
+  /// The window in use: the configured one, or two of the poses' median interval if that is longer
+  /// (at most max_window). Chords start at poses one to two windows old, and a LiDAR slower than
+  /// 4 Hz, or an NDT that cannot keep up and drops scans, has fewer than two poses there: every pose
+  /// would stay unverified.
+  Duration window() const;
 
  private:
   struct Kept {
@@ -47,6 +54,7 @@ class TravelCheck {
   TravelCheckConfig config_;
   OdometryIntegral distance_;
   std::deque<Kept> poses_;
+  std::deque<Duration> intervals_;  ///< between the last poses taken, newest last
 };
 
 }  // namespace coloc::pipeline

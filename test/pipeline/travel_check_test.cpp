@@ -46,6 +46,33 @@ TEST(TravelCheck, APoseWithNothingToCompareYetIsUnverified) {
   for (std::size_t i = 6; i < excess.size(); ++i) EXPECT_TRUE(excess[i].has_value()) << i;
 }
 
+// A LiDAR at 1 Hz (or an NDT that drops scans it cannot keep up with) has no two poses 0.5-1 s back:
+// the window widens to two of its intervals, and its poses are verified and held as at 10 Hz.
+TEST(TravelCheck, ASlowPoseStreamIsVerifiedOverAWindowOfItsOwnPace) {
+  TravelCheck check;
+  const Eigen::Vector2d along(1.0, 0.0);
+  std::vector<std::optional<Eigen::Vector2d>> excess;
+  for (int k = 0; k * 0.02 <= 20.0; ++k) {
+    const double t = k * 0.02;
+    check.addSpeed(at(t), 10.0);
+    if (k % 50 == 0) {
+      const double slide = t >= 15.0 ? 0.5 : 0.0;  // from 15 s on NDT is half a metre ahead
+      excess.push_back(check.check(at(t), (10.0 * t + slide) * along, 0.0));
+    }
+  }
+  ASSERT_EQ(excess.size(), 21u);
+  EXPECT_EQ(check.window(), at(2.0) - at(0.0));
+  // Verified once two intervals' worth of poses are one to two windows old (from the fifth pose on).
+  for (int i = 0; i < 4; ++i) EXPECT_FALSE(excess[i].has_value()) << i;
+  for (int i = 5; i < 15; ++i) {
+    ASSERT_TRUE(excess[i].has_value()) << i;
+    EXPECT_EQ(excess[i]->norm(), 0.0) << i;
+  }
+  // The slide is seen at once, by its excess beyond the tolerance (3 cm + 0.5 % of a 20-40 m chord).
+  ASSERT_TRUE(excess[15].has_value());
+  EXPECT_NEAR(excess[15]->norm(), 0.5 - 0.03 - 0.005 * 30.0, 0.06);
+}
+
 TEST(TravelCheck, NdtThatTravelsWithTheOdometryIsAlmostNeverWidened) {
   // NDT's 1 cm at both ends and the odometry's 5 cm/s over the chord are within the 3 cm tolerance
   // but for a rare draw, and then by millimetres.
