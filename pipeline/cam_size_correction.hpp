@@ -15,9 +15,12 @@ struct CamSizeCorrection {
   double length = 0.0;  ///< m, the body's own, bumper to bumper; 0 = no correction
   double width = 0.0;   ///< m, without mirrors
   double step = 0.1;    ///< m, the CAM's size quantum (ETSI EN 302 637-2)
+  /// m, what this vehicle's CAMs send, where its V2X stack is known to round otherwise than to the
+  /// nearest step (the standard gives the unit, not the rounding); 0 = the size rounded to the nearest step.
+  double sent_length = 0.0, sent_width = 0.0;
 
   bool enabled() const { return length > 0.0 && width > 0.0 && step > 0.0; }
-  /// The size the CAM sends for `size`: rounded to the step, at least one step.
+  /// The size the CAM sends for `size`: rounded to the nearest step, at least one step.
   double sent(double size) const;
   /// The fix's map position corrected; `rsu` the RSU's map position, `yaw` the vehicle's heading.
   Eigen::Vector2d apply(const Eigen::Vector2d& fix, const Eigen::Vector2d& rsu, double yaw) const;

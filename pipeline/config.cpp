@@ -275,6 +275,12 @@ const std::vector<Key>& keys() {
       {"rsu", "cam_size_step", "m", "the step the CAM sends length and width in (ETSI EN 302 637-2: 0.1)",
        [](const C& c) { return show(c.rsu.cam_size_step); },
        [](const R& r, const N& n, const S& k, C& c) { c.rsu.cam_size_step = r.inRange(n, k, 0.001, 1.0); }},
+      {"rsu", "cam_length", "m", "the length this vehicle's CAMs send, where its V2X stack rounds otherwise than to the nearest cam_size_step; 0 = rounded to the nearest",
+       [](const C& c) { return show(c.rsu.cam_length); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.cam_length = r.inRange(n, k, 0.0, 102.2); }},
+      {"rsu", "cam_width", "m", "the width this vehicle's CAMs send (as cam_length); 0 = rounded to the nearest cam_size_step",
+       [](const C& c) { return show(c.rsu.cam_width); },
+       [](const R& r, const N& n, const S& k, C& c) { c.rsu.cam_width = r.inRange(n, k, 0.0, 6.1); }},
       // ---- pipeline
       {"pipeline", "initial_pose", "m, rad", "[x, y, z, yaw] to start the filter at the first input (NDT needs a first guess); null = from the first full pose",
        [](const C& c) { return c.pipeline.initial_pose ? yamlList(*c.pipeline.initial_pose) : S("null"); },

@@ -238,7 +238,7 @@ struct Pipeline::Impl {
         travel_check(TravelCheckConfig{options.map.has_value() ? c.pipeline.travel_check_window : 0.0, c.pipeline.travel_check_tolerance,
                                        c.pipeline.travel_check_tolerance_per_metre}),
         fix_agreement(FixAgreementConfig{options.map.has_value() ? c.pipeline.fix_agreement_window : 0.0, c.pipeline.fix_agreement_tolerance}),
-        cam_size{c.rsu.vehicle_length, c.rsu.vehicle_width, c.rsu.cam_size_step} {
+        cam_size{c.rsu.vehicle_length, c.rsu.vehicle_width, c.rsu.cam_size_step, c.rsu.cam_length, c.rsu.cam_width} {
     const Vector6d& e = c.ndt.source.lidar_pose;
     base_to_lidar = Eigen::Translation3d(e.head<3>()) * Eigen::Quaterniond(quaternionFromRollPitchYaw(e[3], e[4], e[5]));
     localizer.setVerdictListener([this](const fusion::Verdict& v) {

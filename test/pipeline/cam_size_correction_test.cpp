@@ -59,6 +59,18 @@ TEST(CamSizeCorrection, WithoutTheVehiclesSizeOrWithNonFiniteInputTheFixIsTakenA
   EXPECT_NEAR((exact.apply(fix, rsu, 0.3) - fix).norm(), 0.0, 1e-12);
 }
 
+TEST(CamSizeCorrection, AV2xStackThatRoundsDownIsTakenAtWhatItSends) {
+  // The stack sends 4.8 x 1.8 (down, not to the nearest): the box sits 4 cm towards the end seen.
+  const Eigen::Vector2d centre(0.0, 0.0), rsu(20.0, 6.0);
+  const Eigen::Vector2d fix = centre + Eigen::Vector2d(0.5 * (kLength - 4.8), 0.5 * (kWidth - 1.8));
+  CamSizeCorrection nearest{kLength, kWidth, 0.1};
+  EXPECT_GT((nearest.apply(fix, rsu, 0.0) - centre).norm(), 0.04);
+  CamSizeCorrection told = nearest;
+  told.sent_length = 4.8;
+  told.sent_width = 1.8;
+  EXPECT_NEAR((told.apply(fix, rsu, 0.0) - centre).norm(), 0.0, 1e-12);
+}
+
 // Through the pipeline: a car of 4.88 x 1.84 m passes an RSU 8 m to its left, whose fixes place it with
 // its CAM's 4.9 x 1.8 (2 cm towards the RSU on every fix, 1 cm along). Given its own size, the vehicle's
 // estimate sits on its track; without it, 2 cm to the RSU's side.

@@ -85,6 +85,9 @@ struct RsuSection {
   double vehicle_length = 0.0;
   double vehicle_width = 0.0;
   double cam_size_step = 0.1;  ///< m
+  /// What this vehicle's CAMs send as its length and width, where its V2X stack does not round to the
+  /// nearest step (ETSI gives the unit, not the rounding); 0: the size rounded to the nearest step.
+  double cam_length = 0.0, cam_width = 0.0;  ///< m
 };
 
 struct PipelineSection {
