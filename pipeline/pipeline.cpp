@@ -1,6 +1,5 @@
 #include "coloc/pipeline/pipeline.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <variant>
 
 #include "coloc/core/error.hpp"
+#include "coloc/core/principal_variances.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "inbox.hpp"
 #include "initializer.hpp"
@@ -50,14 +50,6 @@ struct NdtResult {
   std::uint64_t timeline;  ///< the pipeline's timeline when the scan was submitted (see Impl::timeline)
 };
 using Input = std::variant<ScanInput, TwistInput, PoseInput, FixInput, InitialPoseInput, NdtResult>;
-
-// The covariance with every direction's variance raised to at least sd^2.
-Eigen::Matrix2d atLeast(const Eigen::Matrix2d& covariance, double sd) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> e(covariance);
-  if (e.info() != Eigen::Success) return covariance;
-  const Eigen::Vector2d raised = e.eigenvalues().cwiseMax(sd * sd);
-  return e.eigenvectors() * raised.asDiagonal() * e.eigenvectors().transpose();
-}
 
 Stamp stampOf(const Input& input) {
   return std::visit(
@@ -519,7 +511,8 @@ struct Pipeline::Impl {
     const double yaw = rollPitchYaw(pose.pose.orientation)[2];
     const std::optional<Eigen::Vector2d> excess = travel_check.check(pose.stamp, pose.pose.position.head<2>(), yaw);
     if (!excess) {
-      pose.covariance.topLeftCorner<2, 2>() = atLeast(pose.covariance.topLeftCorner<2, 2>(), config.pipeline.travel_check_unverified_sd);
+      pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(pose.covariance.topLeftCorner<2, 2>(),
+                                                                         config.pipeline.travel_check_unverified_sd * config.pipeline.travel_check_unverified_sd);
       ++report.ndt_travel_unverified;
     } else if (excess->squaredNorm() > 0.0) {
       pose.covariance.topLeftCorner<2, 2>() += *excess * excess->transpose();

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <sstream>
 
+#include "coloc/core/principal_variances.hpp"
 #include "coloc/core/utf8.hpp"
 
 namespace coloc::rsu_client {
@@ -218,12 +218,9 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
     if (!rsu->calibrated_variance) {
       v.measurement.covariance.topLeftCorner<2, 2>() = sent;
     } else {
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(sent);
       const double figure = registry_.lidarVariance(*rsu) * (1.0 + 1e-6);
-      Eigen::Vector2d variances;
-      for (int i = 0; i < 2; ++i) variances[i] = eigen.eigenvalues()[i] > figure ? std::max(eigen.eigenvalues()[i], variance) : variance;
-      const Eigen::Matrix2d c = eigen.eigenvectors() * variances.asDiagonal() * eigen.eigenvectors().transpose();
-      v.measurement.covariance.topLeftCorner<2, 2>() = 0.5 * (c + c.transpose());
+      v.measurement.covariance.topLeftCorner<2, 2>() =
+          mapPrincipalVariances(sent, [&](double sent_variance) { return sent_variance > figure ? std::max(sent_variance, variance) : variance; });
     }
   }
   return v;

@@ -11,9 +11,9 @@
 #include <memory>
 #include <optional>
 #include <random>
-#include <Eigen/Eigenvalues>
 
 #include "coloc/core/error.hpp"
+#include "coloc/core/principal_variances.hpp"
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/io/v2x_messages.hpp"
@@ -320,10 +320,7 @@ io::Odometry addressedFix(Stamp stamp, const Eigen::Vector2d& position, const Ei
   if (!covariance.allFinite()) return fix;
   // Each principal variance at least the floor: what the fit says beyond it survives as said (a
   // receiver that has calibrated this RSU replaces the floor alone: rsu_client/rsu_fix.cpp).
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(0.5 * (covariance + covariance.transpose()));
-  const Eigen::Vector2d variances = eigen.eigenvalues().cwiseMax(floor);
-  const Eigen::Matrix2d c = eigen.eigenvectors() * variances.asDiagonal() * eigen.eigenvectors().transpose();
-  fix.pose.covariance.topLeftCorner<2, 2>() = 0.5 * (c + c.transpose());
+  fix.pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(covariance, floor);
   return fix;
 }
 

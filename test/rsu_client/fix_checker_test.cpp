@@ -136,6 +136,22 @@ RsuFix sentFix(Stamp stamp, double x) {
   return fix;
 }
 
+// A checker of the registry `yaml` that takes fixes addressed to no one (one vehicle on the road).
+FixChecker acceptingUnaddressed(const std::string& yaml) {
+  FixCheckConfig one_vehicle;
+  one_vehicle.accept_unaddressed = true;
+  return FixChecker(RsuRegistry::parse(yaml, "test"), one_vehicle);
+}
+
+// A sent fix whose x/y covariance is (xx, xy; xy, yy).
+RsuFix sentFixWith(Stamp stamp, double xx, double yy, double xy) {
+  RsuFix fix = sentFix(stamp, 101);
+  fix.sent->covariance(0, 0) = xx;
+  fix.sent->covariance(1, 1) = yy;
+  fix.sent->covariance(0, 1) = fix.sent->covariance(1, 0) = xy;
+  return fix;
+}
+
 TEST(FixChecker, AMessagesFrameCovarianceAndStampFieldAreHeldAgainstTheRegistry) {
   FixChecker c = checker();
   ASSERT_TRUE(c.check(sentFix(kNow - 1000, 101), kNow).accepted());
@@ -183,14 +199,8 @@ TEST(FixChecker, AMessagesFrameCovarianceAndStampFieldAreHeldAgainstTheRegistry)
 // Each fix's covariance from its own fit (roadside/fix_covariance.hpp): a fix sent as less sure than the
 // registry's figure for its LiDAR is taken with what it says, correlation included.
 TEST(FixChecker, AFixSentAsLessSureThanItsLidarsFigureIsTakenWithItsOwnCovariance) {
-  FixCheckConfig one_vehicle;
-  one_vehicle.accept_unaddressed = true;
-  FixChecker c(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n", "test"), one_vehicle);
-  RsuFix fix = sentFix(kNow - 1000, 101);
-  fix.sent->covariance(0, 0) = 0.04;
-  fix.sent->covariance(1, 1) = 0.02;
-  fix.sent->covariance(0, 1) = fix.sent->covariance(1, 0) = 0.01;
-  const FixVerdict v = c.check(fix, kNow);
+  FixChecker c = acceptingUnaddressed("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16}\n");
+  const FixVerdict v = c.check(sentFixWith(kNow - 1000, 0.04, 0.02, 0.01), kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_EQ(v.measurement.covariance(0, 0), 0.04);
   EXPECT_EQ(v.measurement.covariance(1, 1), 0.02);
@@ -199,11 +209,7 @@ TEST(FixChecker, AFixSentAsLessSureThanItsLidarsFigureIsTakenWithItsOwnCovarianc
 }
 
 TEST(FixChecker, ARegistryFrameOtherThanMapAndACalibratedVarianceAreHonoured) {
-  FixCheckConfig one_vehicle;
-  one_vehicle.accept_unaddressed = true;
-  FixChecker c(RsuRegistry::parse("map_frame: earth\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n",
-                                  "test"),
-               one_vehicle);
+  FixChecker c = acceptingUnaddressed("map_frame: earth\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n");
   RsuFix fix = sentFix(kNow - 1000, 101);
   EXPECT_EQ(c.check(fix, kNow).rejection, FixRejection::kWrongFrame);
   fix.sent->frame_id = "earth";
@@ -218,10 +224,7 @@ TEST(FixChecker, ARegistryFrameOtherThanMapAndACalibratedVarianceAreHonoured) {
 // to, not what a fix says beyond it: a far car's fit sent as less sure than the figure keeps its own
 // covariance, each principal variance at least the calibrated one.
 TEST(FixChecker, ACalibratedRsusFixKeepsWhatItSaysBeyondItsLidarsFigure) {
-  FixCheckConfig one_vehicle;
-  one_vehicle.accept_unaddressed = true;
-  FixChecker published(RsuRegistry::parse("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n", "test"),
-                       one_vehicle);
+  FixChecker published = acceptingUnaddressed("rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.0004}\n");
   RsuFix at_figure = sentFix(kNow - 1000, 101);  // sent with the figure, 0.01486
   FixVerdict v = published.check(at_figure, kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
@@ -229,33 +232,22 @@ TEST(FixChecker, ACalibratedRsusFixKeepsWhatItSaysBeyondItsLidarsFigure) {
   EXPECT_NEAR(v.measurement.covariance(1, 1), 0.0004, 1e-15);
   EXPECT_NEAR(v.measurement.covariance(0, 1), 0.0, 1e-15);
   // Principal variances 0.0441 and 0.0159, both beyond the figure: kept as sent.
-  RsuFix far = sentFix(kNow - 900, 101);
-  far.sent->covariance(0, 0) = 0.04;
-  far.sent->covariance(1, 1) = 0.02;
-  far.sent->covariance(0, 1) = far.sent->covariance(1, 0) = 0.01;
-  v = published.check(far, kNow);
+  v = published.check(sentFixWith(kNow - 900, 0.04, 0.02, 0.01), kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_NEAR(v.measurement.covariance(0, 0), 0.04, 1e-12);
   EXPECT_NEAR(v.measurement.covariance(1, 1), 0.02, 1e-12);
   EXPECT_NEAR(v.measurement.covariance(0, 1), 0.01, 1e-12);
   // Only one direction beyond the figure (an RSU raised the other to it): that one kept, the other
   // the calibration's.
-  RsuFix one_face = sentFix(kNow - 850, 101);
-  one_face.sent->covariance(0, 0) = 0.03;
-  v = published.check(one_face, kNow);
+  v = published.check(sentFixWith(kNow - 850, 0.03, 0.01486, 0.0), kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_NEAR(v.measurement.covariance(0, 0), 0.03, 1e-12);
   EXPECT_NEAR(v.measurement.covariance(1, 1), 0.0004, 1e-12);
   // In metres (figure 0.01486^2 = 0.000221) with a calibration of 10 cm: a fit of 20 / 1.7 cm keeps
   // its 20 cm, and the 1.7 cm, below the calibration, takes the calibration's 10.
-  FixChecker metres(RsuRegistry::parse("covariance_placement: standard_deviation\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, "
-                                       "calibrated_variance: 0.01}\n",
-                                       "test"),
-                    one_vehicle);
-  RsuFix fit = sentFix(kNow - 800, 101);
-  fit.sent->covariance(0, 0) = 0.04;
-  fit.sent->covariance(1, 1) = 0.0003;
-  v = metres.check(fit, kNow);
+  FixChecker metres = acceptingUnaddressed(
+      "covariance_placement: standard_deviation\nrsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, calibrated_variance: 0.01}\n");
+  v = metres.check(sentFixWith(kNow - 800, 0.04, 0.0003, 0.0), kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_NEAR(v.measurement.covariance(0, 0), 0.04, 1e-12);
   EXPECT_NEAR(v.measurement.covariance(1, 1), 0.01, 1e-12);

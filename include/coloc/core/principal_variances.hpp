@@ -1,0 +1,27 @@
+#pragma once
+// A planar covariance changed direction by direction: its principal variances mapped, its axes kept.
+// Raising a covariance "to at least" a figure means it in every direction, not on the x and y axes
+// alone (a fit sure along the road and unsure across it keeps that shape), and one solver does it.
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+namespace coloc {
+
+/// The symmetric part of `covariance` with each principal variance v replaced by f(v); the covariance
+/// itself, symmetrized, if it has no real eigen-decomposition.
+template <typename F>
+Eigen::Matrix2d mapPrincipalVariances(const Eigen::Matrix2d& covariance, F f) {
+  const Eigen::Matrix2d symmetric = 0.5 * (covariance + covariance.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> e(symmetric);
+  if (e.info() != Eigen::Success) return symmetric;
+  const Eigen::Vector2d mapped(f(e.eigenvalues()[0]), f(e.eigenvalues()[1]));
+  const Eigen::Matrix2d out = e.eigenvectors() * mapped.asDiagonal() * e.eigenvectors().transpose();
+  return 0.5 * (out + out.transpose());
+}
+
+/// Every direction's variance at least `variance`.
+inline Eigen::Matrix2d principalVariancesAtLeast(const Eigen::Matrix2d& covariance, double variance) {
+  return mapPrincipalVariances(covariance, [variance](double v) { return v < variance ? variance : v; });
+}
+
+}  // namespace coloc
