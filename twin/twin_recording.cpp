@@ -21,6 +21,7 @@
 #include "coloc/ndt/tile_map.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
+#include "coloc/roadside/background_model.hpp"
 #include "coloc/roadside/fix_consistency.hpp"
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/roadside/roadside_perception.hpp"
@@ -183,13 +184,15 @@ class MovingWorld {
   int ego_ = -1;
 };
 
-// Whether another road user the RSU's background does not have (traffic, a car parked since the
-// survey) is within `radius` of the ego vehicle at time t.
-bool neighboursNear(const sim::Scenario& scenario, const sim::Route& route, const Eigen::Vector2d& ego, double t, double radius) {
+// Whether another road user the RSU's background does not have is within `radius` of the ego vehicle
+// at time t: traffic, and a car parked since the survey when the background is the surveyed street
+// (`parked_too`; a background learned on site has it).
+bool neighboursNear(const sim::Scenario& scenario, const sim::Route& route, const Eigen::Vector2d& ego, double t, double radius, bool parked_too) {
   for (const sim::TrafficVehicle& v : scenario.traffic)
     if (const auto pose = sim::trafficPose(route, v, t); pose && (pose->head<2>() - ego).norm() <= radius) return true;
-  for (const sim::SceneObject& o : scenario.objects)
-    if (o.type == "parked_car" && o.in_world && !o.in_map && (o.position - ego).norm() <= radius) return true;
+  if (parked_too)
+    for (const sim::SceneObject& o : scenario.objects)
+      if (o.type == "parked_car" && o.in_world && !o.in_map && (o.position - ego).norm() <= radius) return true;
   return false;
 }
 
@@ -356,6 +359,16 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   const sim::ErrorSources& errors = scenario.errors;
   const std::vector<sim::TriangleMesh> world_meshes = scenario.worldMeshes();
   MovingWorld scene(world_meshes, scenario, errors.detailed_vehicle, false), with_vehicle(world_meshes, scenario, errors.detailed_vehicle, true);
+  // One sweep cast afresh in `world` moved to time t (placing rebuilds its BVH), its time and rays counted.
+  const auto castAt = [&summary](MovingWorld& world, double t, const sim::LidarSpec& spec, const sim::SensorTrajectory& pose, bool& cast_flag) {
+    const auto c0 = Clock::now();
+    world.place(t, nullptr);
+    std::vector<sim::RayHit> hits = sim::castSweep(spec, world.caster(), pose);
+    summary.ray_casting_seconds += since(c0);
+    summary.rays += raysPerSweep(spec);
+    cast_flag = true;
+    return hits;
+  };
   std::unique_ptr<MovingWorld> ideal_world;
   if (options.ideal_comparison) ideal_world = std::make_unique<MovingWorld>(world_meshes, scenario, false, true);
   sim::RayCaster surveyed;
@@ -388,6 +401,39 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   for (std::size_t i = 0; i < scenario.traffic.size(); ++i)
     if (scenario.traffic[i].station_id) connected.push_back(i);
   std::vector<Rsu> rsus;
+  // Each RSU's background as it learns one on site (roadside/background_model): frames of the street
+  // with its traffic passing and its cars parked, never an empty scene, taken before this drive (the
+  // vehicle is not in them). The traffic is where it is at evenly spaced times of the drive. Their hits
+  // are the same on every trial of a site, as the frames' are; the noise is drawn afresh.
+  sim::RandomEngine background_rng(scenario.seed + 59);  // its own stream: the main one unchanged by it
+  const auto learnedBackground = [&](std::size_t index, const sim::LidarSpec& lidar, const Eigen::Isometry3d& pose) {
+    roadside::BackgroundLearner learner;
+    const sim::SensorTrajectory still = [&](double) { return pose; };
+    FrameRoom room;
+    std::vector<Eigen::Vector3f> frame;
+    const int frames = options.rsu_commissioning_frames;
+    std::shared_ptr<const std::vector<sim::RayHit>> hits;
+    for (int k = 0; k < frames; ++k) {
+      const double t = drive.duration() * (k + 0.5) / frames;
+      bool cast_here = false;
+      const auto cast = [&] { return castAt(with_vehicle, t, lidar, still, cast_here); };
+      // Without traffic every frame's rays hit the same: one cast, each frame its own noise.
+      if (!hits || !scenario.traffic.empty()) {
+        const std::uint64_t key = (static_cast<std::uint64_t>(index) << 32) | (0xC0000000ULL + static_cast<std::uint64_t>(k));
+        hits = options.rsu_frames ? options.rsu_frames->get(key, sim::sweepFingerprint(lidar, still, &t, 1), cast)
+                                  : std::make_shared<const std::vector<sim::RayHit>>(cast());
+        if (!cast_here) ++summary.reused_sweeps;
+      }
+      const auto c1 = Clock::now();
+      sim::sweepPoints(lidar, *hits, background_rng, room.points);
+      positionsOf(room.points, frame);
+      summary.lidar_seconds += since(c1);
+      const auto c2 = Clock::now();
+      learner.add(frame);
+      summary.perception_seconds += since(c2);
+    }
+    return learner.background();
+  };
   for (const sim::ScenarioRsu& r : scenario.rsus) {
     roadside::RsuMount mount;
     mount.position = {r.position.x(), r.position.y(), r.height};
@@ -396,7 +442,11 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     mount.pitch = r.pitch;
     const Eigen::Isometry3d pose = rsuPose(r);
     const sim::LidarSpec lidar = sim::withErrors(sim::lidarNamed(r.lidar_model), errors);
-    const std::vector<Eigen::Vector3f> reference = frameOf(lidar, surveyed, pose, rng);
+    // The empty street's frame is drawn either way (one frame, a few ms): the main stream then gives the
+    // roof LiDAR and the vehicle the same draws whichever background the RSUs have, so that the two are
+    // compared on the same drive.
+    std::vector<Eigen::Vector3f> reference = frameOf(lidar, surveyed, pose, rng);
+    if (options.rsu_commissioning_frames > 0) reference = learnedBackground(rsus.size(), lidar, pose);
     const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
     rsu_client::LinkConfig l = options.link;
     l.seed = scenario.seed + rsus.size() + 1;
@@ -489,15 +539,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     };
     // The worlds are moved to the capture time only for a sweep cast afresh (placing rebuilds their BVH).
     bool cast_now = false;
-    auto cast = [&] {
-      const auto c0 = Clock::now();
-      scene.place(capture, nullptr);
-      std::vector<sim::RayHit> hits = sim::castSweep(roof, scene.caster(), roof_pose);
-      summary.ray_casting_seconds += since(c0);
-      summary.rays += raysPerSweep(roof);
-      cast_now = true;
-      return hits;
-    };
+    auto cast = [&] { return castAt(scene, capture, roof, roof_pose, cast_now); };
     {
       const std::shared_ptr<const std::vector<sim::RayHit>> hits =
           options.roof_sweeps ? options.roof_sweeps->get(summary.scans, sim::sweepFingerprint(roof, roof_pose), cast)
@@ -541,7 +583,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     if (ideal_world) ideal_world->place(capture, &seen);
     bool any_in_range = false;
     for (const Rsu& r : rsus) any_in_range = any_in_range || (seen.position - r.info.position).norm() <= r.range;
-    const bool neighbours = any_in_range && neighboursNear(scenario, route, seen.position, capture, 10.0);
+    const bool neighbours = any_in_range && neighboursNear(scenario, route, seen.position, capture, 10.0, options.rsu_commissioning_frames <= 0);
     for (Rsu& r : rsus) {
       const double distance = (seen.position - r.info.position).norm();
       if (distance > r.range) continue;

@@ -69,6 +69,10 @@ struct TwinRecordingOptions {
   /// the vehicle's own size instead of the size its CAM rounds (errors.cam_size_step): a commissioning
   /// probe whose size the operator enters to the millimetre. The fixes sent are unchanged.
   bool probe_size_for_commissioning = false;
+  /// Frames of the busy street (its traffic and parked cars, not the vehicle) each RSU learns its
+  /// background from before the drive (roadside::BackgroundLearner), as an RSU on site does. 0: a frame
+  /// of the empty street as the map surveyed it, which no real RSU has.
+  int rsu_commissioning_frames = 20;
 };
 
 /// The id under which TwinRecordingOptions::perfect_rsus records an RSU's perfect twin.
