@@ -17,6 +17,7 @@ ErrorSources ErrorSources::ideal() {
   e.map_position_sd = 0.0;
   e.map_yaw_sd = 0.0;
   e.cam_size_step = 0.0;
+  e.beam_divergence = 0.0;
   return e;
 }
 

@@ -1,6 +1,8 @@
 #include "coloc/sim/lidar_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <memory>
 #include <mutex>
 
@@ -54,6 +56,7 @@ LidarSpec withErrors(LidarSpec spec, const ErrorSources& errors) {
   spec.range_noise_per_m = errors.range_noise_per_m;
   spec.dropout = errors.dropout;
   spec.dropout_at_max_range = errors.dropout_at_max_range;
+  spec.beam_divergence = errors.beam_divergence;
   return spec;
 }
 
@@ -128,6 +131,91 @@ class PolarPairs {
 
 }  // namespace
 
+namespace {
+
+// The returns where a footprint straddles a depth edge. A ray is at an edge when the same laser's
+// neighbouring firing hit something where it hit nothing, or something 0.1 m nearer or farther than a
+// surface going on evenly would put it. The footprint is taken in three
+// equal parts across the scan: the centre ray's, and on each side of such a neighbour a ray a third of
+// the divergence towards it (on a side without one, the centre's surface goes on). Samples within
+// echo_separation of each other make one echo at their mean range (mixed pixels), and the echo
+// returned is the strongest: the share of the footprint it covers over its range squared, the same
+// reflectivity assumed. Only the rays at edges are cast again.
+void footprintsAtEdges(const LidarSpec& spec, const RayCaster& world, const std::vector<Eigen::Vector3d>& local, const std::vector<Eigen::Matrix3d>& turns,
+                       const std::vector<Eigen::Vector3f>& origins, std::vector<RayHit>& hits) {
+  const int lasers = static_cast<int>(spec.vertical_deg.size());
+  const int firings = firingsPerSweep(spec);
+  // Whether a sample towards `neighbour` can change what `centre` returns: not if it returns nothing
+  // more (the centre's echo stays alone), nor if it is farther by more than echo_separation (a third of
+  // the footprint far away never outshines two thirds near).
+  // A surface seen obliquely steps evenly from firing to firing: a step is an edge only where it
+  // differs by 0.1 m from the step on the centre's other side (or that side returned nothing).
+  const float separation = static_cast<float>(spec.echo_separation);
+  const auto differs = [separation](const RayHit& centre, const RayHit& neighbour, const RayHit& other) {
+    if (neighbour.distance < 0.0f) return false;
+    if (centre.distance < 0.0f) return true;
+    const float step = neighbour.distance - centre.distance;
+    if (other.distance >= 0.0f && std::abs(step - (centre.distance - other.distance)) <= 0.1f) return false;
+    return step < -0.1f || (step > 0.1f && step <= separation);
+  };
+  struct Edge {
+    std::size_t ray;
+    int sides;  ///< bit 0: a sample towards the firing before, bit 1: towards the one after
+    std::size_t first;  ///< its first sample among the casts
+  };
+  thread_local std::vector<Edge> edges;
+  thread_local std::vector<Eigen::Vector3f> sub_origins, sub_directions;
+  thread_local std::vector<RayHit> sub_hits;
+  edges.clear();
+  sub_origins.clear();
+  sub_directions.clear();
+  // The firings' azimuth grows with f: the one before lies at a smaller angle about the sensor's z.
+  const double side = spec.beam_divergence / 3.0;
+  const double c = std::cos(side), s = std::sin(side);
+  for (int f = 0; f < firings; ++f)
+    for (int l = 0; l < lasers; ++l) {
+      const std::size_t i = static_cast<std::size_t>(f * lasers + l);
+      const std::size_t before = static_cast<std::size_t>(((f + firings - 1) % firings) * lasers + l);
+      const std::size_t after = static_cast<std::size_t>(((f + 1) % firings) * lasers + l);
+      const int sides = (differs(hits[i], hits[before], hits[after]) ? 1 : 0) | (differs(hits[i], hits[after], hits[before]) ? 2 : 0);
+      if (!sides) continue;
+      edges.push_back({i, sides, sub_directions.size()});
+      const Eigen::Vector3d& d = local[i];
+      for (const double sign : {-1.0, 1.0}) {
+        if (!(sides & (sign < 0.0 ? 1 : 2))) continue;
+        const Eigen::Vector3d turned(c * d.x() - sign * s * d.y(), sign * s * d.x() + c * d.y(), d.z());
+        sub_origins.push_back(origins[i]);
+        sub_directions.push_back((turns[static_cast<std::size_t>(f)] * turned).normalized().cast<float>());
+      }
+    }
+  if (edges.empty()) return;
+  world.cast(sub_origins, sub_directions, static_cast<float>(spec.max_range), sub_hits);
+  for (const Edge& e : edges) {
+    RayHit samples[3] = {hits[e.ray], hits[e.ray], hits[e.ray]};
+    std::size_t next = e.first;
+    if (e.sides & 1) samples[1] = sub_hits[next++];
+    if (e.sides & 2) samples[2] = sub_hits[next++];
+    std::sort(std::begin(samples), std::end(samples), [](const RayHit& a, const RayHit& b) {
+      return (a.distance >= 0.0f) != (b.distance >= 0.0f) ? a.distance >= 0.0f : a.distance < b.distance;
+    });
+    RayHit best;
+    double best_energy = 0.0;
+    for (int first = 0; first < 3 && samples[first].distance >= 0.0f;) {
+      int last = first;
+      double sum = 0.0;
+      while (last < 3 && samples[last].distance >= 0.0f && samples[last].distance - samples[first].distance <= spec.echo_separation)
+        sum += samples[last++].distance;
+      const double range = sum / (last - first);
+      const double energy = (last - first) / (range * range);
+      if (energy > best_energy) best_energy = energy, best = {static_cast<float>(range), samples[first].mesh};
+      first = last;
+    }
+    hits[e.ray] = best;
+  }
+}
+
+}  // namespace
+
 std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose) {
   std::vector<RayHit> hits;
   castSweep(spec, world, pose, hits);
@@ -142,12 +230,15 @@ void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajec
   const std::vector<Eigen::Vector3d>& local = table->exact;
   // Reused between sweeps of a thread: fresh buffers of this size cost page faults every sweep.
   thread_local std::vector<Eigen::Vector3f> origins, directions;
+  thread_local std::vector<Eigen::Matrix3d> turns;  // the sensor's orientation at each firing
   const std::size_t rays = static_cast<std::size_t>(firings * lasers);
   origins.resize(rays);
   directions.resize(rays);
+  turns.resize(static_cast<std::size_t>(firings));
   for (int f = 0; f < firings; ++f) {
     const double t = sweep * f / firings;
     const Eigen::Isometry3d sensor = pose(t);
+    turns[static_cast<std::size_t>(f)] = sensor.linear();
     const Eigen::Vector3f origin = sensor.translation().cast<float>();
     for (int l = 0; l < lasers; ++l) {
       const std::size_t i = static_cast<std::size_t>(f * lasers + l);
@@ -156,6 +247,7 @@ void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajec
     }
   }
   world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
+  if (spec.beam_divergence > 0.0) footprintsAtEdges(spec, world, local, turns, origins, hits);
 }
 
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng) {

@@ -140,6 +140,41 @@ TEST(LidarModel, RangeNoiseAndLostReturnsGrowWithRangeAsConfigured) {
   EXPECT_NEAR(ringScan(ideal, 80.0f).noise_sd, 0.02, 0.001);
 }
 
+// One laser level with the ground, firing 0 straight along x; a wall 40 m ahead and, nearer, a surface
+// whose edge lies `edge` rad to the left of that firing's centre ray (the surface covers everything
+// beyond it), at `near` m.
+RayHit firingAtAnEdge(double divergence, double near, double edge) {
+  RayCaster world;
+  world.addMesh(box({40.0f, 0.0f, -5.0f}, {0.2f, 40.0f, 10.0f}));
+  const float y0 = static_cast<float>(near * std::tan(edge));
+  world.addMesh(box({static_cast<float>(near) + 0.1f, y0 + 2.0f, -5.0f}, {0.2f, 4.0f, 10.0f}));
+  world.commit();
+  LidarSpec spec;
+  spec.name = "one laser";
+  spec.vertical_deg = {0.0};
+  spec.azimuth_offset_deg = {0.0};
+  spec.beam_divergence = divergence;
+  return castSweep(spec, world, [](double) { return Eigen::Isometry3d::Identity(); })[0];
+}
+
+// A real laser's footprint widens with range (Velodyne: 3 mrad across the scan). Where it straddles an
+// edge, what it returns is not what its centre ray hits: a nearer surface covering a third of it is the
+// stronger echo (the edge blooms outwards), and two surfaces closer than a pulse's length merge into
+// one echo between them (a mixed pixel). Away from edges, and without divergence, the centre ray's.
+TEST(LidarModel, AFootprintAcrossAnEdgeReturnsTheStrongerEchoOrAMixedRange) {
+  const double divergence = 3e-3;
+  // Without divergence the centre ray passes the edge 0.5 mrad away and hits the wall.
+  EXPECT_NEAR(firingAtAnEdge(0.0, 20.0, 0.5e-3).distance, 39.9, 0.01);
+  // With it, a third of the footprint lies on the surface at 20 m: (1/3) / 20^2 outshines (2/3) / 40^2.
+  EXPECT_NEAR(firingAtAnEdge(divergence, 20.0, 0.5e-3).distance, 20.0, 0.01);
+  // A surface farther from the edge than a third of the divergence is not seen.
+  EXPECT_NEAR(firingAtAnEdge(divergence, 20.0, 1.2e-3).distance, 39.9, 0.01);
+  // A third of the footprint at 39.6 m and two at 39.9 m: one echo at their mean.
+  EXPECT_NEAR(firingAtAnEdge(divergence, 39.6, 0.5e-3).distance, (39.6 + 2 * 39.9) / 3.0, 0.01);
+  // The centre on the near surface: a third beyond the edge does not outshine it.
+  EXPECT_NEAR(firingAtAnEdge(divergence, 20.0, -0.5e-3).distance, 20.0, 0.01);
+}
+
 #if defined(__GLIBCXX__)
 // The twin's results were made with libstdc++'s std::normal_distribution and uniform draws, two per ray
 // in ray order, hit or not; the sweep's own draws (whose log is skipped for rays that return nothing)

@@ -44,6 +44,10 @@ struct ErrorSources {
   /// in units of 0.1 m): the body then differs from the box the perception places by up to half a
   /// step (the twin's car, 4.88 x 1.84 m, is sent as 4.9 x 1.8). 0: the exact body size (the ideal twin).
   double cam_size_step = 0.1;  ///< m
+  /// Every LiDAR's horizontal beam divergence (LidarSpec::beam_divergence): returns at depth edges are
+  /// mixed or bloom, as a real footprint makes them. Velodyne's manuals: 3.0 mrad horizontal, 1.5
+  /// vertical (the vertical is not modelled). 0: each return is its centre ray's (the ideal twin).
+  double beam_divergence = 3.0e-3;  ///< rad
 
   /// The ideal twin: perfect surveys (RSU and map), clocks and LiDAR mounting, box-shaped car, 2 cm range noise, no dropouts.
   static ErrorSources ideal();

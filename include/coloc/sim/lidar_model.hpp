@@ -25,9 +25,18 @@ struct LidarSpec {
   double dropout_at_max_range = 0.0;  ///< further share lost at max_range, growing with (range / max_range)^2
   double min_range = 0.9;     ///< m
   double max_range = 100.0;   ///< m
+  /// The laser's footprint widens with range by this full angle across the scan (rad; Velodyne: 3.0
+  /// mrad horizontal, 1.5 vertical). Where it straddles a depth edge (a car's outline against what lies
+  /// behind), the return is not the centre ray's: echoes closer than `echo_separation` merge into one
+  /// at a range between them (mixed pixels), farther ones are told apart and the strongest is
+  /// returned (the sensor's default mode: a near edge covering part of the footprint blooms outwards).
+  /// 0: each return is its centre ray's.
+  double beam_divergence = 0.0;
+  double echo_separation = 0.5;  ///< m; a pulse of a few ns, our estimate
 };
 
 /// Velodyne's published calibration (ros-drivers/velodyne VLP16db.yaml, VeloView-VLP-32C.yaml).
+/// Their beam divergence is set by withErrors (ErrorSources::beam_divergence).
 LidarSpec vlp16();
 LidarSpec vlp32c();
 /// A 64-beam LiDAR with evenly spread beams (45 deg vertical, 1024 columns), as on roadside poles; an
