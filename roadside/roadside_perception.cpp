@@ -197,6 +197,10 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   std::vector<Eigen::Vector3d> foreground;  // map frame, z = height above the road under the point
   std::vector<double> foreground_z;         // the map's z of each
   int far_occluders = 0;
+  // Background in front of the vehicle: its points, and which of 20 equal parts of the footprint's
+  // bearings they fall in (the two at each end: where the footprint's outline is).
+  int background_occluders = 0;
+  std::vector<bool> hidden(20, false);
   std::vector<int> index(1);
   std::vector<float> distance_sq(1);
   const double background_sq = c.background_distance * c.background_distance;
@@ -207,8 +211,18 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     if (!near && !(c.attribute && inSector(xy, in_map.z()))) continue;
     const double height = in_map.z() - road.height(xy);
     if (height < 0.05) continue;  // the road itself
-    if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq)
+    if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq) {
+      // What stands still between the LiDAR and the vehicle (a parked car, a hedge) hides part of it as
+      // much as what moves: background to the clustering, an occluder all the same, by the share of the
+      // footprint's bearings it covers (a post or a sign's pole in front of a car hides a strip of it).
+      if (c.attribute && inSector(xy, in_map.z())) {
+        const double b = wrapAngle(std::atan2(xy.y() - lidar.y(), xy.x() - lidar.x()) - bearing0);
+        const auto bin = static_cast<std::size_t>(std::clamp((b - bearing_lo) / (bearing_hi - bearing_lo + 1e-9), 0.0, 0.999) * hidden.size());
+        hidden[bin] = true;
+        ++background_occluders;
+      }
       continue;
+    }
     if (near) {
       foreground.emplace_back(xy.x(), xy.y(), height);
       foreground_z.push_back(in_map.z());
@@ -283,6 +297,9 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     //    puts the box on the wrong corner.
     const auto occluding = [&](const Object* except) {
       int n = far_occluders;
+      if (background_occluders >= c.occlusion_points &&
+          std::count(hidden.begin(), hidden.end(), true) >= static_cast<long>(std::ceil(c.background_occlusion_share * hidden.size())))
+        n += background_occluders;
       for (const Object& o : objects)
         if (&o != except)
           for (std::size_t i : o.points) n += inSector(foreground[i].head<2>(), foreground_z[i]) ? 1 : 0;
