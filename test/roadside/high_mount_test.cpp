@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "coloc/roadside/roadside_perception.hpp"
@@ -20,6 +21,8 @@ using namespace coloc::sim;  // the twin makes the frames
 struct Outcome {
   int frames = 0, found = 0;
   std::vector<double> errors;
+  std::vector<std::pair<double, double>> by_range;  ///< (range, error) of each fix
+  std::array<int, 4> frames_by_range{};            ///< frames at 20-30, 30-40, 40-50, 50-60 m
   std::vector<double> nis;  ///< each fix's error squared, normalized by its covariance (chi-square, 2 dof)
   double beyond3sd() const {
     return nis.empty() ? 0.0 : static_cast<double>(std::count_if(nis.begin(), nis.end(), [](double v) { return v > 9.0; })) / nis.size();
@@ -71,10 +74,12 @@ Outcome drivePast(const LidarSpec& ideal, double height, double pitch_deg) {
     for (const LidarPoint& p : scanSweep(lidar, world, sensor, rng)) frame.push_back(p.position);
     const VehicleDetection d = perception.detect(frame, 0, {x + 0.2, -0.22}, yaw + 0.03, cam_length, cam_width);
     ++out.frames;
+    ++out.frames_by_range[std::min<std::size_t>(3, static_cast<std::size_t>((range - 20.0) / 10.0))];
     if (d.found) {
       ++out.found;
       const Eigen::Vector2d e = d.position - Eigen::Vector2d(x, 0.0);
       out.errors.push_back(e.norm());
+      out.by_range.emplace_back(range, e.norm());
       out.nis.push_back(e.dot(d.covariance.inverse() * e));
     }
   }
@@ -102,6 +107,17 @@ TEST(HighMount, FixesFromAMastAndFromPolesAreAccurateAndTheirCovarianceHonest) {
     std::printf("%-8s %.0f m: %2d of %2d frames give a fix, median %.3f m, p90 %.3f m, worst %.3f m; normalized error squared: mean %.2f, "
                 "beyond 3 sd %.1f %%\n",
                 c.lidar.name.c_str(), c.height, o.found, o.frames, o.median(), o.quantile(0.9), o.quantile(1.0), o.meanNis(), 100.0 * o.beyond3sd());
+    // The same by range, beside the real roadside frames' figures (docs/roadside.md).
+    std::printf("  by range:");
+    for (int bin = 0; bin < 4; ++bin) {
+      std::vector<double> e;
+      for (const auto& [range, error] : o.by_range)
+        if (range >= 20.0 + 10.0 * bin && (range < 30.0 + 10.0 * bin || bin == 3)) e.push_back(error);
+      std::sort(e.begin(), e.end());
+      std::printf(" %d-%d m %zu of %d, median %.1f cm;", 20 + 10 * bin, 30 + 10 * bin, e.size(), o.frames_by_range[static_cast<std::size_t>(bin)],
+                  e.empty() ? std::nan("") : 100.0 * e[e.size() / 2]);
+    }
+    std::printf("\n");
     fixes += static_cast<int>(o.nis.size());
     beyond += static_cast<int>(std::count_if(o.nis.begin(), o.nis.end(), [](double v) { return v > 9.0; }));
     EXPECT_LE(o.quantile(1.0), 0.5) << c.lidar.name << " " << c.height << " m: a fix over 50 cm was sent";
