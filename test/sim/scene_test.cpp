@@ -86,6 +86,12 @@ TEST(Scenario, UnstatedRsuSurveyAndClockErrorsAreDrawnOncePerInstallationFromThe
   EXPECT_EQ(e.errors.survey_position_sd, 0.0);
   EXPECT_NEAR(parseScenario(std::string(kRoute) + "errors: {lidar_mount_yaw_deg: -0.5}\n", "s.yaml").errors.lidar_mount_yaw, -0.5 * M_PI / 180.0, 1e-15);
   expectError(std::string(kRoute) + "errors: {lidar_mount_yaw_deg: 20}\n", "errors.lidar_mount_yaw_deg");
+  // Every LiDAR's footprint: Velodyne's 3 mrad unless stated, none in the ideal twin.
+  EXPECT_DOUBLE_EQ(s.errors.beam_divergence, 3e-3);
+  EXPECT_EQ(ideal.errors.beam_divergence, 0.0);
+  EXPECT_DOUBLE_EQ(parseScenario(std::string(kRoute) + "errors: {beam_divergence_mrad: 1.5}\n", "s.yaml").errors.beam_divergence, 1.5e-3);
+  expectError(std::string(kRoute) + "errors: {beam_divergence_mrad: -1}\n", "errors.beam_divergence_mrad: must be in [0, 20]");
+  expectError(std::string(kRoute) + "errors: {beam_divergence_mrad: .nan}\n", "errors.beam_divergence_mrad: must not be NaN");
   expectError(std::string(kRoute) + "errors: {fog: 1}\n", "errors.fog: unknown key");
   expectError(std::string(kRoute) + "errors: {dropout: 1.5}\n", "errors.dropout");
   expectError(std::string(kRoute) + "errors: {vehicle_body: blob}\n", "errors.vehicle_body: expected one of detailed, boxes");
