@@ -198,7 +198,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   std::vector<double> foreground_z;         // the map's z of each
   int far_occluders = 0;
   // Background in front of the vehicle: its points, and which of 20 equal parts of the footprint's
-  // bearings they fall in (the two at each end: where the footprint's outline is).
+  // bearings they fall in.
   int background_occluders = 0;
   std::vector<bool> hidden(20, false);
   std::vector<int> index(1);

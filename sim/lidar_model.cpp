@@ -129,27 +129,22 @@ class PolarPairs {
   double x_ = 0.0, y_ = 0.0, r2_ = 1.0, scale_ = 0.0;
 };
 
-}  // namespace
-
-namespace {
-
 // The returns where a footprint straddles a depth edge. A ray is at an edge when the same laser's
 // neighbouring firing hit something where it hit nothing, or something 0.1 m nearer or farther than a
-// surface going on evenly would put it. The footprint is taken in three
-// equal parts across the scan: the centre ray's, and on each side of such a neighbour a ray a third of
-// the divergence towards it (on a side without one, the centre's surface goes on). Samples within
-// echo_separation of each other make one echo at their mean range (mixed pixels), and the echo
-// returned is the strongest: the share of the footprint it covers over its range squared, the same
-// reflectivity assumed. Only the rays at edges are cast again.
+// surface going on evenly would put it. The footprint is taken in three equal parts across the scan:
+// the centre ray's, and on each side of such a neighbour a ray a third of the divergence towards it (on
+// a side without one, the centre's surface goes on). Samples within echo_separation of each other make
+// one echo at their mean range (mixed pixels), and the echo returned is the strongest: the share of the
+// footprint it covers over its range squared, the same reflectivity assumed. Only the rays at edges are
+// cast again.
 void footprintsAtEdges(const LidarSpec& spec, const RayCaster& world, const std::vector<Eigen::Vector3d>& local, const std::vector<Eigen::Matrix3d>& turns,
                        const std::vector<Eigen::Vector3f>& origins, std::vector<RayHit>& hits) {
   const int lasers = static_cast<int>(spec.vertical_deg.size());
   const int firings = firingsPerSweep(spec);
-  // Whether a sample towards `neighbour` can change what `centre` returns: not if it returns nothing
-  // more (the centre's echo stays alone), nor if it is farther by more than echo_separation (a third of
-  // the footprint far away never outshines two thirds near).
-  // A surface seen obliquely steps evenly from firing to firing: a step is an edge only where it
-  // differs by 0.1 m from the step on the centre's other side (or that side returned nothing).
+  // Whether a sample towards `neighbour` can change what `centre` returns: not if the neighbour returned
+  // nothing (the centre's echo stays alone), nor if it is farther by more than echo_separation (a third
+  // of the footprint far away never outshines two thirds near), nor where the step to it is the step
+  // from `other` on the centre's far side, within 0.1 m (a surface seen obliquely steps evenly).
   const float separation = static_cast<float>(spec.echo_separation);
   const auto differs = [separation](const RayHit& centre, const RayHit& neighbour, const RayHit& other) {
     if (neighbour.distance < 0.0f) return false;

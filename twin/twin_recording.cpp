@@ -337,6 +337,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     throw Error("twin: the RSU's processing time must be a finite number of seconds >= 0");
   if (!(std::isfinite(options.oracle_fix_limit) && options.oracle_fix_limit >= 0.0))
     throw Error("twin: the oracle fix limit must be a finite number of metres >= 0 (0: off)");
+  if (options.rsu_commissioning_frames < 0 || options.rsu_commissioning_frames > 10000)
+    throw Error("twin: the RSUs' commissioning frames must be 0-10000 (0: the surveyed empty street), not " +
+                std::to_string(options.rsu_commissioning_frames));
   if (options.perfect_rsus)
     for (const sim::ScenarioRsu& a : scenario.rsus)
       for (const sim::ScenarioRsu& b : scenario.rsus)

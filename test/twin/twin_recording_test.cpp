@@ -240,6 +240,9 @@ TEST(TwinRecording, RefusesALinkOrProcessingTimeOutOfRangeBeforeSimulating) {
   TwinRecordingOptions bad_processing;
   bad_processing.rsu_processing = std::nan("");
   EXPECT_NE(message(bad_processing).find("processing time must be a finite number"), std::string::npos);
+  TwinRecordingOptions bad_commissioning;
+  bad_commissioning.rsu_commissioning_frames = -5;
+  EXPECT_NE(message(bad_commissioning).find("commissioning frames must be 0-10000 (0: the surveyed empty street), not -5"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "drive" / "map"));  // refused before the survey
 }
 
