@@ -35,12 +35,19 @@ void addSimulateCommand(CLI::App& app) {
   cmd->add_flag("--rsu-frames", options.record_rsu_frames,
                 "also record what each RSU's own node takes in (coloc rsu-node): its LiDAR frames on /rsu/<id>/points and the "
                 "connected vehicles' CAMs on /v2x/cam");
+  static std::string rsu_background = "learned";
+  cmd->add_option("--rsu-background", rsu_background,
+                  "how each RSU gets its background: learned from frames of the busy street before the drive, as on site, or "
+                  "surveyed, the empty street as the map has it (no real RSU has one)")
+      ->check(CLI::IsMember({"learned", "surveyed"}))
+      ->capture_default_str();
   static bool ideal = false;
   cmd->add_flag("--ideal", ideal, "drive the ideal twin: the scenario without its error sources (errors: preset ideal)");
   cmd->callback([] {
     sim::Scenario scenario = sim::loadScenario(scenario_path);
     if (ideal) sim::setErrorSources(scenario, sim::ErrorSources::ideal());
     options.out_dir = out_dir;
+    if (rsu_background == "surveyed") options.rsu_commissioning_frames = 0;
     ProgressBar progress("simulating");
     options.progress = [&](double f) { progress.update(f); };
     const TwinRecordingSummary s = recordTwin(scenario, options);

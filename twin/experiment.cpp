@@ -481,6 +481,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     // where the LiDAR is, only where its fixes are said to be, and when).
     r.options.perfect_rsus = drive.variant == kNextDrive;
     r.options.oracle_fix_limit = config.oracle_fix_limit;
+    if (!config.rsu_background_learned) r.options.rsu_commissioning_frames = 0;  // the surveyed empty street
     // The noise calibration drive is the commissioning pass: its vehicle is the operator's probe, whose
     // size is entered as measured, not as a CAM rounds it; the variance of its fixes as sent is the
     // operating vehicles'.

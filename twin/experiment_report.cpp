@@ -690,8 +690,10 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
        << sources_md.str() << "\n";
   if (!attribution_md.str().empty())
     md << "## Other road users: what the roadside perception sent\n\nEvery RSU frame within coverage on the evaluated trials; "
-          "\"with neighbours\": another vehicle the RSU's background does not have within 10 m of the ego vehicle (traffic: each RSU "
-          "learns its background from frames of the street with its traffic and parked cars before the drive).\n\n"
+          "\"with neighbours\": another vehicle the RSU's background does not have within 10 m of the ego vehicle "
+       << (c.rsu_background_learned ? "(traffic: each RSU learns its background from frames of the street with its traffic and parked cars before the drive)"
+                                    : "(traffic, and a car parked since the survey: each RSU's background is the empty street as surveyed)")
+       << ".\n\n"
        << attribution_md.str() << "\n";
   if (!ndt_md.str().empty()) md << "## The filter against its best input: NDT's own poses\n\n" << ndt_md.str() << "\n";
   if (c.network)

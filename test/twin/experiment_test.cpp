@@ -38,6 +38,7 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_TRUE(c.errors.empty());
   EXPECT_FALSE(c.recordings);  // the drives are replayed from memory unless asked
   EXPECT_EQ(c.oracle_fix_limit, 0.0);  // the analysis bound is off
+  EXPECT_TRUE(c.rsu_background_learned);  // as an RSU on site learns it, from the busy street
   EXPECT_EQ(c.network_trials, 10);  // the grid on every trial: one trial's change spreads by 5-18 points
   EXPECT_EQ(quickExperiment(c).trials, 1);
 }
@@ -67,6 +68,9 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_TRUE(parseExperimentConfig("recordings: true\n", "exp.yaml").recordings);
   EXPECT_NE(errorOf("recordings: often\n").find("exp.yaml:1: recordings"), std::string::npos) << errorOf("recordings: often\n");
   EXPECT_DOUBLE_EQ(parseExperimentConfig("oracle_fix_limit: 0.02\n", "exp.yaml").oracle_fix_limit, 0.02);
+  EXPECT_FALSE(parseExperimentConfig("rsu_background: surveyed\n", "exp.yaml").rsu_background_learned);
+  EXPECT_NE(errorOf("rsu_background: empty\n").find("exp.yaml:1: rsu_background: expected one of learned, surveyed"), std::string::npos)
+      << errorOf("rsu_background: empty\n");
   EXPECT_NE(errorOf("oracle_fix_limit: -0.02\n").find("exp.yaml:1: oracle_fix_limit: must be in [0, 100]"), std::string::npos)
       << errorOf("oracle_fix_limit: -0.02\n");
 }

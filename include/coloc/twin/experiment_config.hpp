@@ -96,6 +96,10 @@ struct ExperimentConfig {
   /// An analysis bound on every drive (TwinRecordingOptions::oracle_fix_limit): the RSUs withhold each
   /// fix farther than this from the vehicle's true position, which no RSU can know. m; 0: off.
   double oracle_fix_limit = 0.0;
+  /// How each RSU gets its background (`rsu_background`): learned from frames of the busy street before
+  /// each drive, as an RSU on site does (TwinRecordingOptions::rsu_commissioning_frames), or the surveyed
+  /// empty street, which no real RSU has (what the twin did before; for comparison).
+  bool rsu_background_learned = true;
 };
 
 /// The quick mode: one trial of everything, for a first look in a minute or two.
