@@ -2,6 +2,8 @@
 // (cdr_check.hpp).
 #include "coloc/io/v2x_messages.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <functional>
 
@@ -24,6 +26,8 @@ void checkCam(CdrChecker& c) {
 }
 
 }  // namespace
+
+double camSizeSent(double size, double step) { return step > 0.0 ? std::max(step, std::round(size / step) * step) : size; }
 
 Eigen::Vector2d Cam::centre() const { return reference - 0.5 * length * Eigen::Vector2d(std::cos(heading), std::sin(heading)); }
 

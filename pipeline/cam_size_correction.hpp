@@ -20,8 +20,6 @@ struct CamSizeCorrection {
   double sent_length = 0.0, sent_width = 0.0;
 
   bool enabled() const { return length > 0.0 && width > 0.0 && step > 0.0; }
-  /// The size the CAM sends for `size`: rounded to the nearest step, at least one step.
-  double sent(double size) const;
   /// The fix's map position corrected; `rsu` the RSU's map position, `yaw` the vehicle's heading.
   Eigen::Vector2d apply(const Eigen::Vector2d& fix, const Eigen::Vector2d& rsu, double yaw) const;
 };

@@ -489,7 +489,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   }
   std::mt19937_64 cam_rng(scenario.seed + 53);  // the recorded CAMs' errors: a stream of their own
   // The size a CAM tells the RSUs (errors.cam_size_step).
-  const auto camSize = [step = errors.cam_size_step](double size) { return step > 0.0 ? std::max(step, std::round(size / step) * step) : size; };
+  const auto camSize = [step = errors.cam_size_step](double size) { return io::camSizeSent(size, step); };
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
@@ -565,8 +565,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         c.heading = pose.z();
         c.speed = speed;
         c.yaw_rate = yaw_rate;
-        c.length = std::max(0.1, std::round(b.length * 10.0) / 10.0);
-        c.width = std::max(0.1, std::round(b.width * 10.0) / 10.0);
+        c.length = camSize(b.length);
+        c.width = camSize(b.width);
         const Eigen::Vector2d centre = pose.head<2>() + Eigen::Vector2d(error(cam_rng), error(cam_rng));
         c.reference = centre + 0.5 * c.length * Eigen::Vector2d(std::cos(c.heading), std::sin(c.heading));
         bag.write(rsu_client::kCamTopic, at(t) + 1'000'000, io::encodeCam(c));

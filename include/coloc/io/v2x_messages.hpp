@@ -36,6 +36,10 @@ struct Cam {
   Eigen::Vector2d centre() const;
 };
 
+/// The length or width a CAM carries for a body of `size` (m): ETSI EN 302 637-2 gives the unit, 0.1 m,
+/// and this rounds to the nearest step, at least one step; `step` 0: the size exact (the ideal twin).
+double camSizeSent(double size, double step = 0.1);
+
 Bytes encodeCam(const Cam& cam);
 /// Also refuses non-finite numbers and a size that is not positive.
 Cam decodeCam(const std::uint8_t* data, std::size_t size);
