@@ -10,7 +10,7 @@ packages=(
   libfastcdr-dev libfastrtps-dev fastddsgen
   libsqlite3-dev libzstd-dev liblz4-dev libyaml-cpp-dev openssl iproute2
   libcli11-dev nlohmann-json3-dev
-  libpcl-dev libembree-dev libceres-dev
+  libpcl-dev libembree-dev libceres-dev libabsl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   cyclonedds-dev cyclonedds-tools
 )

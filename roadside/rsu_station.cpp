@@ -1,5 +1,6 @@
 #include "coloc/roadside/rsu_station.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "coloc/core/error.hpp"
@@ -12,6 +13,7 @@ struct RsuStation::Impl {
   BackgroundLearner learner;
   std::optional<RoadsidePerception> perception;
   int since_rebuild = 0;
+  int since_learned = 0;  ///< frames since the last one learned, once commissioned
   std::map<std::uint32_t, ConnectedVehicle> vehicles;
   std::map<std::uint32_t, FixConsistency> tracks;
   std::optional<Stamp> last_frame;
@@ -24,6 +26,11 @@ struct RsuStation::Impl {
   void rebuild() {
     const std::vector<Eigen::Vector3f> background = learner.background();
     if (background.empty()) return;  // nothing returned often enough yet: keep learning
+    build(background);
+  }
+
+  /// The perception from `background` (sensor frame): learned, or a frame of the empty scene.
+  void build(const std::vector<Eigen::Vector3f>& background) {
     // The first time, the LiDAR's tilt from the road it sees, if asked (the registry's otherwise).
     if (config.level_from_ground && !levelled) {
       std::vector<Eigen::Vector3d> sensor;
@@ -48,7 +55,8 @@ RsuStation::RsuStation(const RsuMount& mount, RsuStationConfig config) {
     throw Error("RSU station: the mount's position and angles must be finite");
   if (!(config.coverage > 0.0) || !(config.max_cam_age > 0.0) || !(config.forget_after >= config.max_cam_age))
     throw Error("RSU station: coverage and max_cam_age must be > 0, forget_after at least max_cam_age");
-  if (config.commissioning_frames < 1 || config.refresh_frames < 1) throw Error("RSU station: commissioning_frames and refresh_frames must be >= 1");
+  if (config.commissioning_frames < 1 || config.refresh_frames < 1 || config.learn_every < 1)
+    throw Error("RSU station: commissioning_frames, refresh_frames and learn_every must be >= 1");
   impl_ = std::make_unique<Impl>(mount, config);
 }
 
@@ -76,6 +84,19 @@ bool RsuStation::commission() {
   impl_->rebuild();
   return commissioned();
 }
+
+bool RsuStation::commission(const std::vector<Eigen::Vector3f>& empty_scene) {
+  Impl& d = *impl_;
+  if (std::none_of(empty_scene.begin(), empty_scene.end(), [](const Eigen::Vector3f& p) { return p.allFinite(); })) return false;
+  d.learner.add(empty_scene);
+  ++d.counters.commissioning_frames;
+  d.build(empty_scene);
+  return true;
+}
+
+std::vector<Eigen::Vector3f> RsuStation::background() const { return impl_->learner.background(); }
+
+const RoadsidePerception* RsuStation::perception() const { return impl_->perception ? &*impl_->perception : nullptr; }
 
 bool RsuStation::addVehicle(const ConnectedVehicle& v) {
   Impl& d = *impl_;
@@ -108,11 +129,15 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
     ++d.counters.clock_resets;
   }
   d.last_frame = stamp;
-  d.learner.add(points);
   if (!d.perception) {
+    d.learner.add(points);
     ++d.counters.commissioning_frames;
     if (static_cast<int>(d.counters.commissioning_frames) >= d.config.commissioning_frames) d.rebuild();
     return {};
+  }
+  if (++d.since_learned >= d.config.learn_every) {
+    d.learner.add(points);
+    d.since_learned = 0;
   }
   if (++d.since_rebuild >= d.config.refresh_frames) d.rebuild();
   // Vehicles long gone are forgotten with their tracks: a busy intersection sees thousands a day.

@@ -25,6 +25,7 @@
 #include "coloc/roadside/fix_consistency.hpp"
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/roadside/roadside_perception.hpp"
+#include "coloc/roadside/rsu_station.hpp"
 #include "coloc/sim/survey_map.hpp"
 #include "coloc/sim/vehicle_body.hpp"
 #include "coloc/replay/replay_cache.hpp"
@@ -116,7 +117,7 @@ class LogRecorder {
     m.log_time = log_time;
     messages_.push_back(std::move(m));
     decoded_.resize(messages_.size());
-    decoded_.back() = {stamp, ScanPool::shared().make(sweep.size(), [&](ndt::PointCloud& cloud) { scanOf(sweep, cloud); })};
+    decoded_.back() = {stamp, ScanPool::shared().make(sweep.size(), [&](ndt::PointCloud& cloud) { scanOf(sweep, cloud); }), std::string()};  // given decoded: no header
   }
   /// A roadside LiDAR's frame, in its sensor frame: written to the file only (coloc rsu-node reads it);
   /// in memory it is a message without a decoded scan.
@@ -389,15 +390,19 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   struct Rsu {
     sim::ScenarioRsu info;
     sim::LidarSpec lidar;
-    std::vector<roadside::RoadsidePerception> perception;  ///< kVariants, or only the first
+    /// The RSU's perception over time, as its node runs it (roadside::RsuStation): the connected
+    /// vehicles' CAMs, its background kept up to date from the frames, each vehicle's track.
+    roadside::RsuStation station;
+    /// The perception without each refinement (kVariants, with perception_ablation), on the background
+    /// the station was commissioned with: what each step buys.
+    std::vector<roadside::RoadsidePerception> ablation;
     rsu_client::LinkEmulator link;
     double variance;
     double range;
     sim::LidarSpec ideal_lidar;
     std::unique_ptr<roadside::RoadsidePerception> ideal_perception;
-    roadside::FixConsistency consistency{}, ideal_consistency{};
-    /// Per other connected vehicle: its track and its share of the radio link.
-    std::vector<roadside::FixConsistency> connected_consistency;
+    roadside::FixConsistency ideal_consistency{};
+    /// Per other connected vehicle: its share of the radio link.
     std::vector<rsu_client::LinkEmulator> connected_links;
   };
   std::vector<std::size_t> connected;  // the traffic that is connected
@@ -409,8 +414,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
   // vehicle is not in them). The traffic is where it is at evenly spaced times of the drive. Their hits
   // are the same on every trial of a site, as the frames' are; the noise is drawn afresh.
   sim::RandomEngine background_rng(scenario.seed + 59);  // its own stream: the main one unchanged by it
-  const auto learnedBackground = [&](std::size_t index, const sim::LidarSpec& lidar, const Eigen::Isometry3d& pose) {
-    roadside::BackgroundLearner learner;
+  const auto learnBackground = [&](std::size_t index, const sim::LidarSpec& lidar, const Eigen::Isometry3d& pose, roadside::RsuStation& station) {
     const sim::SensorTrajectory still = [&](double) { return pose; };
     FrameRoom room;
     std::vector<Eigen::Vector3f> frame;
@@ -432,10 +436,10 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       positionsOf(room.points, frame);
       summary.lidar_seconds += since(c1);
       const auto c2 = Clock::now();
-      learner.add(frame);
+      station.learn(frame);
       summary.perception_seconds += since(c2);
     }
-    return learner.background();
+    station.commission();
   };
   for (const sim::ScenarioRsu& r : scenario.rsus) {
     roadside::RsuMount mount;
@@ -448,23 +452,33 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     // The empty street's frame is drawn either way (one frame, a few ms): the main stream then gives the
     // roof LiDAR and the vehicle the same draws whichever background the RSUs have, so that the two are
     // compared on the same drive.
-    std::vector<Eigen::Vector3f> reference = frameOf(lidar, surveyed, pose, rng);
-    if (options.rsu_commissioning_frames > 0) reference = learnedBackground(rsus.size(), lidar, pose);
+    const std::vector<Eigen::Vector3f> empty_street = frameOf(lidar, surveyed, pose, rng);
     const rsu_client::LidarModel* model = rsu_client::findLidarModel(r.lidar_model);
+    // The twin casts an RSU's frame only while the vehicle is truly within the LiDAR's range; the
+    // station's own gate, on the CAM's position, is wider by five of the CAM's 0.3 m sd so that it
+    // looks for the vehicle in every frame cast for it.
+    roadside::RsuStationConfig station_config;
+    station_config.coverage = model->range + 1.5;
+    roadside::RsuStation station(mount, station_config);
+    if (options.rsu_commissioning_frames > 0) learnBackground(rsus.size(), lidar, pose, station);
+    else station.commission(empty_street);
+    if (!station.commissioned()) throw Error("twin: RSU " + r.id + " learned no background from its commissioning frames");
+    std::vector<roadside::RoadsidePerception> ablation;
+    if (options.perception_ablation) {
+      const std::vector<Eigen::Vector3f> reference = options.rsu_commissioning_frames > 0 ? station.background() : empty_street;
+      for (const PerceptionVariant& v : kVariants) {
+        roadside::RoadsidePerceptionConfig c;
+        c.align_true_size = v.align_true_size;
+        c.height_cut = v.height_cut;
+        ablation.emplace_back(reference, mount, c);
+      }
+    }
     rsu_client::LinkConfig l = options.link;
     l.seed = scenario.seed + rsus.size() + 1;
-    std::vector<roadside::RoadsidePerception> perception;
-    for (std::size_t v = 0; v < (options.perception_ablation ? kVariants.size() : 1); ++v) {
-      roadside::RoadsidePerceptionConfig c;
-      c.align_true_size = kVariants[v].align_true_size;
-      c.height_cut = kVariants[v].height_cut;
-      perception.emplace_back(reference, mount, c);
-    }
-    Rsu rsu{r, lidar, std::move(perception), rsu_client::LinkEmulator(l), model->sigma, model->range, {}, nullptr};
+    Rsu rsu{r, lidar, std::move(station), std::move(ablation), rsu_client::LinkEmulator(l), model->sigma, model->range, {}, nullptr, roadside::FixConsistency(), {}};
     for (std::size_t j = 0; j < connected.size(); ++j) {
       rsu_client::LinkConfig own = l;
       own.seed = l.seed * 1000003ULL + 104729ULL * (j + 1);  // its own draws: the ego's link unchanged by it
-      rsu.connected_consistency.emplace_back();
       rsu.connected_links.emplace_back(own);
     }
     if (ideal_world) {
@@ -621,24 +635,58 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       // The frame as the RSU's LiDAR driver publishes it: stamped at the sweep's start, in its own frame.
       if (options.record_rsu_frames)
         bag.writeRoadsideFrame(rsu_client::roadsidePointsTopic(r.info.id), at(t + 0.1) + 5'000'000, frame_room.points, at(t), r.info.id);
-      // Every other connected vehicle in the same frame gets its own fix, found through its own CAM and
-      // addressed to its station id, on the same topic: the ego's radio hears them all.
+      // The CAMs the RSU holds at the capture time: every connected vehicle's within range, each with
+      // its own error of about 0.3 m, its size in the CAM's steps. Every other connected vehicle in the
+      // same frame gets its own fix, found through its own CAM and addressed to its station id, on the
+      // same topic: the ego's radio hears them all.
+      std::map<std::uint32_t, std::size_t> others;  // station id -> index in `connected`
       for (std::size_t j = 0; j < connected.size(); ++j) {
         const sim::TrafficVehicle& other = scenario.traffic[connected[j]];
         const std::optional<Eigen::Vector3d> at_capture = sim::trafficPose(route, other, capture);
         if (!at_capture || (at_capture->head<2>() - r.info.position).norm() > r.range) continue;
         std::normal_distribution<double> cam_error(0.0, 0.3);
-        const Eigen::Vector2d cam_position = at_capture->head<2>() + Eigen::Vector2d(cam_error(connected_rng), cam_error(connected_rng));
-        roadside::VehicleDetection od =
-            r.perception[0].detect(frame, at(capture), cam_position, at_capture->z(), camSize(other.body.length), camSize(other.body.width));
-        const Eigen::Vector2d other_velocity = other.speed * Eigen::Vector2d(std::cos(at_capture->z()), std::sin(at_capture->z()));
-        if (!od.found) {
-          r.connected_consistency[j].miss();
+        roadside::ConnectedVehicle v;
+        v.stamp = at(capture);
+        v.station_id = *other.station_id;
+        v.centre = at_capture->head<2>() + Eigen::Vector2d(cam_error(connected_rng), cam_error(connected_rng));
+        v.heading = at_capture->z();
+        v.speed = other.speed;
+        v.length = camSize(other.body.length);
+        v.width = camSize(other.body.width);
+        r.station.addVehicle(v);
+        others[v.station_id] = j;
+      }
+      // The ego's CAM: a reference position with the vehicle's own error, about 0.3 m.
+      std::normal_distribution<double> cam(0.0, 0.3);
+      const Eigen::Vector2d reference = seen.position + Eigen::Vector2d(cam(rng), cam(rng));
+      {
+        roadside::ConnectedVehicle v;
+        v.stamp = at(capture);
+        v.station_id = scenario.vehicle_station_id;
+        v.centre = reference;
+        v.heading = seen.yaw;
+        v.speed = seen.speed;
+        v.yaw_rate = seen.yaw_rate;
+        v.length = camSize(body.length);
+        v.width = camSize(body.width);
+        r.station.addVehicle(v);
+      }
+      const auto c_station = Clock::now();
+      const std::vector<roadside::StationOutcome> outcomes = r.station.frame(frame, at(capture));
+      summary.perception_seconds += since(c_station);
+      roadside::VehicleDetection d;
+      d.refusal = roadside::Refusal::kNoVehicle;  // unless the station looked: it always does (its gate is wider)
+      for (const roadside::StationOutcome& o : outcomes) {
+        if (o.station_id == scenario.vehicle_station_id) {
+          d = o.detection;
           continue;
         }
-        if (!r.connected_consistency[j].agrees(od.stamp, od.position, other_velocity)) continue;
-        const std::optional<Stamp> sent = r.connected_links[j].transmit(at(capture + 0.05 + options.rsu_processing));
+        const auto j = others.find(o.station_id);
+        if (j == others.end() || !o.detection.found) continue;  // a CAM the frame no longer holds the vehicle of
+        const sim::TrafficVehicle& other = scenario.traffic[connected[j->second]];
+        const std::optional<Stamp> sent = r.connected_links[j->second].transmit(at(capture + 0.05 + options.rsu_processing));
         if (!sent) continue;
+        const roadside::VehicleDetection& od = o.detection;
         const Eigen::Vector2d local = Eigen::Rotation2Dd(r.info.yaw).inverse() * (od.position - r.info.position);
         const Eigen::Vector2d reported = r.info.position + r.info.survey_error.head<2>() + Eigen::Rotation2Dd(r.info.yaw + r.info.survey_error.z()) * local;
         const Eigen::Matrix2d turn = Eigen::Rotation2Dd(r.info.survey_error.z()).toRotationMatrix();
@@ -647,16 +695,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
                                                   *other.station_id)));
         ++summary.connected_fixes;
       }
-      // The CAM gives the RSU a reference position with the vehicle's own error, about 0.3 m.
-      std::normal_distribution<double> cam(0.0, 0.3);
-      const Eigen::Vector2d reference = seen.position + Eigen::Vector2d(cam(rng), cam(rng));
-      roadside::VehicleDetection d;
-      for (std::size_t v = 0; v < r.perception.size(); ++v) {
-        const roadside::VehicleDetection dv = r.perception[v].detect(frame, at(capture), reference, seen.yaw, camSize(body.length), camSize(body.width));
-        if (v == 0) {
-          d = dv;
-          summary.perception_seconds += d.processing_ms * 1e-3;
-        }
+      for (std::size_t v = 0; v < r.ablation.size(); ++v) {
+        const roadside::VehicleDetection dv = r.ablation[v].detect(frame, at(capture), reference, seen.yaw, camSize(body.length), camSize(body.width));
         const double e = dv.found ? (dv.position - seen.position).norm() : std::nan("");
         ablation_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << ","
                      << kVariants[v].name << "," << (dv.found ? 1 : 0) << "," << e << "\n";
@@ -672,7 +712,6 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         if (!det.found) return consistency.miss();
         if (!consistency.agrees(det.stamp, det.position, velocity)) det.found = false, det.refusal = roadside::Refusal::kInconsistent;
       };
-      confirm(d, r.consistency);
       RsuFrameRecord record;
       record.distance = distance;
       record.neighbours = neighbours;
@@ -727,7 +766,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       // A probe whose size the operator enters: the same frame fitted with the body's own size, the
       // survey then not taking the CAM's rounding.
       if (options.probe_size_for_commissioning && (camSize(body.length) != body.length || camSize(body.width) != body.width)) {
-        const roadside::VehicleDetection probe = r.perception[0].detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
+        const roadside::VehicleDetection probe = r.station.perception()->detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
         if (probe.found)
           summary.probe_fix_samples[r.info.id].push_back(
               {r.info.position + r.info.survey_error.head<2>() + surveyed_yaw * (true_yaw.inverse() * (probe.position - r.info.position)),

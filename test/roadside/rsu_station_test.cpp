@@ -202,6 +202,66 @@ TEST_F(Station, AnUnknownTiltIsTakenFromTheRoadWhileCommissioning) {
   EXPECT_GT(median_unlevelled, 2.0 * median);
 }
 
+// After commissioning the station keeps learning, one frame in learn_every: a car that parks becomes
+// background once it has been in enough of the frames learned (here nothing forgotten, and the
+// background rebuilt every frame), so that its CAM then finds no vehicle where it stands, or only part
+// of one. Learning one frame in four, that takes four times as many frames.
+TEST_F(Station, ACarParkedSinceCommissioningBecomesBackgroundAfterAsManyLearnedFrames) {
+  const auto framesUntilLost = [&](int learn_every) {
+    RsuStationConfig config;
+    config.commissioning_frames = 20;
+    config.refresh_frames = 1;
+    config.learn_every = learn_every;
+    config.background.decay = 0.0;
+    RsuStation station(mount_, config);
+    commissionOnAnEmptyStreet(station, 20);
+    const std::vector<Car> parked = {{25, 0, 0, 0}, {-100, 0, 30, 0}, {-110, 0, 30, 0}};
+    place(parked, 0.0);
+    bool fixed = false;  // the first frame has no track to agree with: lost once it had a fix
+    for (int k = 1; k <= 80; ++k) {
+      station.addVehicle(cam(1001, parked[0], 0.1 * k, 5.0));
+      const std::vector<StationOutcome> o = station.frame(frame(), fromSeconds(0.1 * k + 5.0));
+      const bool found = o.size() == 1u && o[0].detection.found;
+      if (fixed && !found) return k;
+      fixed = fixed || found;
+    }
+    return 1000;
+  };
+  const int every_frame = framesUntilLost(1), every_fourth = framesUntilLost(4);
+  std::printf("a parked car becomes background after %d frames learning each, %d learning one in four\n", every_frame, every_fourth);
+  EXPECT_GE(every_frame, 3) << "not in the background before it has been in a few frames";
+  EXPECT_LE(every_frame, 10);
+  EXPECT_GE(every_fourth, 4 * every_frame - 4);
+  EXPECT_LE(every_fourth, 4 * every_frame + 4);
+}
+
+// A survey's frame of the empty street instead of commissioning frames: fixes from the first frames,
+// the second once the track has a first to agree with.
+TEST_F(Station, CommissionedFromASurveyedEmptyFrameItFixesFromTheFirstFrames) {
+  RsuStation station(mount_);
+  place({{-80, 0, 30, 0}, {-90, 0, 30, 0}, {-100, 0, 30, 0}}, 0.0);
+  EXPECT_FALSE(station.commission(std::vector<Eigen::Vector3f>(3, Eigen::Vector3f::Constant(std::nanf(""))))) << "no finite point";
+  EXPECT_FALSE(station.commissioned());
+  ASSERT_TRUE(station.commission(frame()));
+  ASSERT_NE(station.perception(), nullptr);
+  const std::vector<Car> cars = {{-40, 6, 0, 0}, {-100, 0, 30, 0}, {-110, 0, 30, 0}};
+  place(cars, 0.0);
+  for (int k = 0; k < 4; ++k) {
+    const double t = 0.1 * k;
+    place(cars, t);
+    station.addVehicle(cam(1001, cars[0], t));
+    const std::vector<StationOutcome> o = station.frame(frame(), fromSeconds(t));
+    ASSERT_EQ(o.size(), 1u);
+    if (k == 0) {  // no track yet to agree with
+      EXPECT_EQ(o[0].detection.refusal, Refusal::kInconsistent);
+      continue;
+    }
+    ASSERT_TRUE(o[0].detection.found) << "frame " << k << ": " << toString(o[0].detection.refusal);
+    EXPECT_LT((o[0].detection.position - at(cars[0], t)).norm(), 0.15);
+  }
+  EXPECT_EQ(station.counters().commissioning_frames, 1u);
+}
+
 TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {
   RsuStationConfig config;
   config.commissioning_frames = 2;

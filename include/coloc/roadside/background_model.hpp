@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
-#include <unordered_map>
+#include <memory>
 #include <vector>
 
 namespace coloc::roadside {
@@ -27,28 +27,27 @@ struct BackgroundConfig {
 class BackgroundLearner {
  public:
   explicit BackgroundLearner(BackgroundConfig config = {});
+  ~BackgroundLearner();
+  BackgroundLearner(BackgroundLearner&&) noexcept;
+  BackgroundLearner& operator=(BackgroundLearner&&) noexcept;
 
   /// One frame, in the sensor frame. Non-finite points are skipped.
   void add(const std::vector<Eigen::Vector3f>& frame);
   /// Frames learned (their decayed weight, with a decay).
   double frames() const { return frames_ * scale_; }
-  /// One point per background voxel, the mean of its returns, in the sensor frame.
+  /// One point per background voxel, the mean of its returns, in the sensor frame; in the voxels'
+  /// order (by index), so that what is built from it does not depend on how the voxels are stored.
   std::vector<Eigen::Vector3f> background() const;
   /// Voxels seen at all (background or not).
-  std::size_t voxels() const { return cells_.size(); }
+  std::size_t voxels() const;
   const BackgroundConfig& config() const { return config_; }
 
  private:
   // Weights are kept divided by the decay's product so far (`scale_`), so that a frame touches only
   // the voxels it hits; they are brought back to scale before that product underflows.
-  struct Cell {
-    double frames = 0.0;  ///< frames with a return here
-    double points = 0.0;  ///< returns here
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();  ///< of the returns, each weighted as `points`
-    std::uint64_t last_frame = 0;  ///< the frame that last counted here (1-based)
-  };
+  struct Cells;  // the voxels seen, by index (a flat hash table: one lookup per return of every frame)
   BackgroundConfig config_;
-  std::unordered_map<std::uint64_t, Cell> cells_;
+  std::unique_ptr<Cells> cells_;
   double frames_ = 0.0;  ///< at scale
   std::uint64_t frame_index_ = 0;
   double scale_ = 1.0;

@@ -34,13 +34,16 @@ struct RsuStationConfig {
   double forget_after = 10.0;     ///< s without a CAM after which a vehicle and its track are forgotten
   int commissioning_frames = 50;  ///< frames learned before the first fix
   int refresh_frames = 100;       ///< afterwards, the background is rebuilt from what was learned this often
+  /// Afterwards, one frame in this many is learned: the background changes over minutes, and learning
+  /// a 64-beam frame costs about as much as looking for two vehicles in it.
+  int learn_every = 5;
   /// Take the LiDAR's roll and pitch from the road its background shows (RoadSurface's plane in the
   /// sensor frame) instead of the mount's: for a pole whose tilt nobody measured. The tilt to the road,
   /// so a road's grade is counted as tilt.
   bool level_from_ground = false;
   BackgroundConfig background = [] {
     BackgroundConfig b;
-    b.decay = 1.0 / 3000.0;  // five minutes at 10 Hz: a car parked longer becomes background
+    b.decay = 1.0 / 600.0;  // per frame learned: five minutes at 10 Hz learning every 5th frame; a car parked longer becomes background
     return b;
   }();
   RoadsidePerceptionConfig perception;
@@ -78,6 +81,16 @@ class RsuStation {
   /// frame() looks for vehicles from its first call.
   void learn(const std::vector<Eigen::Vector3f>& points);
   bool commission();
+  /// Commissioning from a frame of the empty scene (a survey's) instead: the perception is built from
+  /// it as it is, and it is learned as a first frame, so that the background kept up to date from the
+  /// frames that follow starts from it. False (and nothing changes) if the frame has no finite point.
+  bool commission(const std::vector<Eigen::Vector3f>& empty_scene);
+
+  /// The background learned so far (BackgroundLearner::background), sensor frame.
+  std::vector<Eigen::Vector3f> background() const;
+  /// The perception frame() uses, null before commissioning: to fit a frame otherwise than frame() does
+  /// (another size, a probe), without the vehicles' tracks.
+  const RoadsidePerception* perception() const;
 
   bool commissioned() const;
   const StationCounters& counters() const;
