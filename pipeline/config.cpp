@@ -213,6 +213,10 @@ const std::vector<Key>& keys() {
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.fixed_covariance = readVariances(r, n, k); }},
       {"ndt", "covariance_floor", "m^2, rad^2", "laplace and multi_ndt_score: each variance (x, y, z, roll, pitch, yaw) at least this", [](const C& c) { return yamlList(c.ndt.source.ndt.covariance_floor); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.ndt.covariance_floor = readVariances(r, n, k); }},
+      {"ndt", "quality_map", "",
+       "NDT's mean square error by place, from a drive with a reference (the ndt_quality.yaml coloc fuse writes for a log with ground truth; relative to this file): each NDT pose's x/y variance at least its cell's; null = none",
+       [](const C& c) { return quoted(c.ndt.quality_map); },
+       [](const R& r, const N& n, const S& k, C& c) { c.ndt.quality_map = n.IsNull() ? S() : r.text(n, k); }},
       {"ndt", "min_range", "m", "scan points closer than this are dropped (the vehicle itself)", [](const C& c) { return show(c.ndt.source.preprocess.min_range); },
        [](const R& r, const N& n, const S& k, C& c) { c.ndt.source.preprocess.min_range = r.number(n, k); }},
       {"ndt", "max_range", "m", "scan points farther than this are dropped", [](const C& c) { return show(c.ndt.source.preprocess.max_range); },
@@ -530,6 +534,8 @@ Config loadConfig(const std::string& path) {
   namespace fs = std::filesystem;
   if (!config.rsu.registry.empty() && fs::path(config.rsu.registry).is_relative())
     config.rsu.registry = (fs::path(path).parent_path() / config.rsu.registry).lexically_normal().string();
+  if (!config.ndt.quality_map.empty() && fs::path(config.ndt.quality_map).is_relative())
+    config.ndt.quality_map = (fs::path(path).parent_path() / config.ndt.quality_map).lexically_normal().string();
   return config;
 }
 

@@ -17,6 +17,7 @@
 #include "speed_scale.hpp"
 #include "cam_size_correction.hpp"
 #include "fix_agreement.hpp"
+#include "coloc/pipeline/ndt_quality_map.hpp"
 #include "travel_check.hpp"
 #include "mount_yaw.hpp"
 #include "yaw_rate_bias.hpp"
@@ -187,6 +188,7 @@ struct Pipeline::Impl {
   MountYawEstimator mount_yaw;
   TravelCheck travel_check;
   FixAgreement fix_agreement;
+  NdtQualityMap ndt_quality;  ///< empty without ndt.quality_map
   CamSizeCorrection cam_size;
   Eigen::Isometry3d base_to_lidar = Eigen::Isometry3d::Identity();  // the configured extrinsic
   bool first_input_seen = false;
@@ -236,6 +238,7 @@ struct Pipeline::Impl {
     localizer.setVerdictListener([this](const fusion::Verdict& v) {
       if (v.rejected()) reject(v.message());
     });
+    if (options.map && !c.ndt.quality_map.empty()) ndt_quality = NdtQualityMap::load(c.ndt.quality_map);
     if (options.map) {
       ndt::NdtPoseSourceConfig ndt_config = config.ndt.source;
       // Offline the target is built inline: the same log then gives the same bytes, whatever the machine's speed.
@@ -506,6 +509,13 @@ struct Pipeline::Impl {
     // and the mounting yaw (each from NDT's poses as matched: the yaw's differences do not see it).
     // Not while the filter is lost or its position doubted by the map: NDT's poses may then match
     // another place, and what they would teach about the odometry is not the vehicle's.
+    // Where a drive with a reference measured NDT's error (ndt.quality_map), its pose is worth no more
+    // than NDT was there, whatever the fit's sharpness says.
+    if (const double place = ndt_quality.varianceAt(pose.pose.position.head<2>()); place > 0.0) {
+      const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
+      pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(xy, place);
+      if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_raised;
+    }
     // Where NDT's travel disagrees with the odometry's, its pose is worth no more than the disagreement.
     // A pose with nothing to compare yet is taken at no better than the unverified figure.
     const double yaw = rollPitchYaw(pose.pose.orientation)[2];

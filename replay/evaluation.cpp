@@ -131,4 +131,15 @@ ErrorStats errorStats(const std::vector<ErrorSample>& errors) {
   return s;
 }
 
+pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, double cell, std::size_t min_poses) {
+  std::vector<pipeline::NdtQualitySample> samples;
+  samples.reserve(ndt.size());
+  double sum = 0.0;
+  for (const ErrorSample& s : ndt) {
+    samples.push_back({s.estimate, s.estimate - s.truth});
+    sum += 0.5 * samples.back().error.squaredNorm();
+  }
+  return pipeline::NdtQualityMap::fromErrors(samples, cell, min_poses, samples.empty() ? 0.0 : sum / static_cast<double>(samples.size()));
+}
+
 }  // namespace coloc::replay

@@ -71,6 +71,7 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
     j["ndt_travel_check"] = {{"disagreements", pipeline_report.ndt_travel_disagreements}, {"max_excess_m", pipeline_report.ndt_travel_max_excess},
                              {"unverified", pipeline_report.ndt_travel_unverified}};
     j["ndt_fix_agreement"] = {{"disagreements", pipeline_report.ndt_fix_disagreements}, {"max_excess_m", pipeline_report.ndt_fix_max_excess}};
+    j["ndt_quality_map"] = {{"raised", pipeline_report.ndt_quality_raised}};
     j["odometry_speed_scale"] = {{"scale", speed_scale}, {"compared_m", speed_scale_distance}};
     j["odometry_yaw_rate_bias"] = {{"bias_rad_s", yaw_rate_bias}, {"compared_s", yaw_rate_bias_time}};
     j["lidar_mount_yaw"] = {{"yaw_rad", mount_yaw}, {"compared_m", mount_yaw_distance}};

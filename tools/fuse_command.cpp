@@ -83,6 +83,9 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     if (r.pipeline_report.ndt_fix_disagreements > 0)
       std::printf("  NDT's position against the roadside's fixes: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m)\n",
                   (unsigned long long)r.pipeline_report.ndt_fix_disagreements, r.pipeline_report.ndt_fix_max_excess);
+    if (r.pipeline_report.ndt_quality_raised > 0)
+      std::printf("  NDT's error by place (ndt.quality_map): %llu poses' covariance raised to their place's figure\n",
+                  (unsigned long long)r.pipeline_report.ndt_quality_raised);
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
     std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
     std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);
@@ -103,8 +106,10 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
   }
   std::printf("  fused %zu poses (%.1f s) in %.3f s: %.0fx real time\n", r.fused.size(), toSeconds(r.last_stamp - r.first_stamp),
               r.wall_seconds, r.wall_seconds > 0 ? r.log_duration / r.wall_seconds : 0.0);
-  std::printf("  wrote %s/{fused.tum, summary.json, trajectory.svg%s}\n", out_dir.c_str(),
-              r.errors.empty() ? "" : ", error.csv, error.svg, input_error.csv, input_error.svg");
+  const bool quality = r.input_errors.count(pipeline::kNdtSource) && !r.input_errors.at(pipeline::kNdtSource).empty();
+  std::printf("  wrote %s/{fused.tum, summary.json, trajectory.svg%s%s}\n", out_dir.c_str(),
+              r.errors.empty() ? "" : ", error.csv, error.svg, input_error.csv, input_error.svg",
+              quality ? ", ndt_quality.yaml (NDT's error by place, for ndt.quality_map)" : "");
 }
 
 void writePlots(const ReplayResult& r, const std::string& dir, const std::string& log) {
@@ -182,6 +187,9 @@ void addFuseCommand(CLI::App& app) {
     std::ofstream(out_dir + "/timing.json") << timing.dump(2) << "\n";
     if (!result.errors.empty()) result.writeErrorCsv(out_dir + "/error.csv");
     if (!result.input_errors.empty()) result.writeInputErrorCsv(out_dir + "/input_error.csv");
+    // NDT's error by place, for later drives on the same roads (ndt.quality_map): a log with ground truth.
+    if (const auto ndt = result.input_errors.find(pipeline::kNdtSource); ndt != result.input_errors.end() && !ndt->second.empty())
+      std::ofstream(out_dir + "/ndt_quality.yaml") << replay::ndtQualityMap(ndt->second).toYaml();
     writePlots(result, out_dir, log);
     printSummary(log, result, out_dir, !options.map.empty());
   });

@@ -132,6 +132,8 @@ struct Job {
   bool smooth = false;     ///< also smooth the log: `smoothed`
   bool calibrate = false;  ///< smooth with the RSUs' calibrations: `calibrations`, `calibrated`
   Stamp until = 0;         ///< the replay ends here (0: at the log's end): replay::ReplayOptions::until
+  bool keep_ndt_errors = false;  ///< keep NDT's own error per pose: `ndt_errors`
+  std::vector<replay::ErrorSample> ndt_errors;
   std::optional<ExperimentRun> smoothed;
   std::map<std::string, smoother::RsuCalibration> calibrations;  ///< per RSU id, with `calibrate`
   std::optional<rsu_client::RsuRegistry> calibrated;  ///< the registry with the calibrations found
@@ -147,6 +149,9 @@ void writeReplayConfig(const Job& job, const std::string& dir) {
     std::ofstream(dir + "/" + name + "_rsu.yaml") << job.registry->toYaml();
     config.rsu.registry = name + "_rsu.yaml";
   }
+  // As coloc fuse reads it: relative to the configuration's folder.
+  if (!config.ndt.quality_map.empty())
+    config.ndt.quality_map = fs::relative(fs::absolute(config.ndt.quality_map), fs::absolute(dir)).string();
   // Its figures all lie within coverage: the experiment ended the replay there (the same figures).
   const std::string ended = job.until ? "# (the experiment ended it at stamp " + formatSeconds(job.until) + ", past the RSUs' coverage)\n" : std::string();
   std::ofstream(dir + "/" + name + ".yaml") << pipeline::configYaml(
@@ -236,6 +241,8 @@ void runJob(Job& job) {
   }
   fillRun(job.run, r.ground_truth, r.errors, job.rsu_positions);
   if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) job.run.ndt = c->second;
+  if (job.keep_ndt_errors)
+    if (auto e = r.input_errors.find(pipeline::kNdtSource); e != r.input_errors.end()) job.ndt_errors = std::move(e->second);
   const auto fused = [&](const std::string& topic) { return std::find(job.fix_topics.begin(), job.fix_topics.end(), topic) != job.fix_topics.end(); };
   for (const fusion::SourceReport& s : r.sources)
     if (std::find(job.fix_sources.begin(), job.fix_sources.end(), s.name) != job.fix_sources.end()) {
@@ -427,6 +434,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU id -> variance
   std::vector<Eigen::Vector2d> twist_variance(config.sites.size(), Eigen::Vector2d::Zero());  // per site: vx, wz
   std::vector<std::optional<Eigen::Vector2d>> ndt_variance(config.sites.size());  // per site: x/y, yaw
+  std::vector<std::string> ndt_quality(config.sites.size());  // per site: NDT's error by place (its file)
 
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
   struct Recorded {
@@ -592,7 +600,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         if (config.ndt_covariance == NdtCovarianceSource::kEstimated) cov[5] = (*v)[1];
         if (config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
           job.config.ndt.source.ndt.covariance = ndt::CovarianceMode::kMultiNdtScore;
-          job.config.ndt.source.ndt.covariance_floor = cov;  // NDT's error on the calibration drive the floor
+          if (!ndt_quality[drive.site].empty()) {
+            // NDT's error on the calibration drive where the pose is the floor; the aligner's own at its default.
+            job.config.ndt.quality_map = ndt_quality[drive.site];
+          } else {
+            job.config.ndt.source.ndt.covariance_floor = cov;  // NDT's error on the calibration drive the floor
+          }
         }
       }
       if (config.twist_covariance_estimated) {
@@ -649,7 +662,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       }
       twist_variance[drive.site] = odometryVariance(summary.odometry, scenario.name);
       // NDT alone on this drive, against ground truth: its covariance for the evaluated drives.
-      if (config.ndt_covariance != NdtCovarianceSource::kPublished) jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
+      if (config.ndt_covariance != NdtCovarianceSource::kPublished) {
+        jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
+        jobs.back().keep_ndt_errors = true;  // NDT's error by place
+      }
       for (const sim::ScenarioRsu& r : scenario.rsus)
         if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end()) results.ideal_comparison[reportKey(scenario, r)] = f->second;
       results.estimated_twist_variance[scenario.name] = twist_variance[drive.site];
@@ -790,6 +806,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (drive.variant == kNoiseCalibrationDrive) {
         ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
         results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
+        if (config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
+          const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
+          ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();
+          std::ofstream(ndt_quality[drive.site]) << quality.toYaml();
+          results.ndt_quality_cells[scenario.name] = quality.cells();
+        }
         continue;  // never evaluated
       }
       if (j.calibrate && j.registry) {

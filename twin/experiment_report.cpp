@@ -732,7 +732,18 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
       md << " (Autoware's fixed matrix says 15 cm and 1.4 deg). The filter takes it ";
       switch (c.ndt_covariance) {
         case NdtCovarianceSource::kMultiNdtScore:
-          md << "as the floor of NDT's covariance from its score (x/y raised where the score is flat along a direction; yaw Autoware's).";
+          if (!results.ndt_quality_cells.empty()) {
+            md << "where no place says otherwise; NDT's x/y covariance from its score (raised where the score is flat along a direction; yaw "
+                  "Autoware's) is floored at NDT's mean square error on that drive where the pose is, per 10 m cell with 5 poses or more (";
+            bool first_site = true;
+            for (const auto& [site, cells] : results.ndt_quality_cells) {
+              md << (first_site ? "" : ", ") << site << " " << cells << " cells";
+              first_site = false;
+            }
+            md << "; `ndt_quality.yaml` of each noise calibration drive, `ndt.quality_map`).";
+          } else {
+            md << "as the floor of NDT's covariance from its score (x/y raised where the score is flat along a direction; yaw Autoware's).";
+          }
           break;
         case NdtCovarianceSource::kEstimatedPosition: md << "for NDT's x/y covariance (yaw Autoware's)."; break;
         case NdtCovarianceSource::kEstimated: md << "for NDT's x/y and yaw covariance."; break;

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <thread>
 
@@ -13,6 +14,7 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/ndt/pcd_file.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
+#include "coloc/pipeline/ndt_quality_map.hpp"
 #include "coloc/pipeline/static_transforms.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "real_data.hpp"
@@ -333,6 +335,50 @@ ReplayResult replayAgainstThePairsMap(const std::string& log, const std::string&
   options.map = testing::realData("hdl32e_pair/target.pcd");
   options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\nndt:\n  voxel_size: 1.0\n" + extra_config, "test.yaml");
   return replayLog(log, options);
+}
+
+// NDT's error by place (ndt.quality_map): where a drive with a reference found NDT poor, its poses are
+// worth no more than that, whatever their fit says; elsewhere they are as NDT gives them. A map that
+// cannot be read stops the replay before anything is fused, naming the file.
+TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
+  testing::TempDir dir;
+  writeScanLog(dir / "scans", 3);
+  const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
+  const Eigen::Vector2d here(gt1(0, 3), gt1(1, 3));
+  // One cell (10 m) around where the scans are matched, NDT 0.5 m off there on the reference drive;
+  // another far away.
+  std::vector<pipeline::NdtQualitySample> samples;
+  for (int i = 0; i < 5; ++i) samples.push_back({here, Eigen::Vector2d(0.5, 0.5)});
+  for (int i = 0; i < 5; ++i) samples.push_back({here + Eigen::Vector2d(100.0, 0.0), Eigen::Vector2d(0.01, 0.0)});
+  const pipeline::NdtQualityMap poor = pipeline::NdtQualityMap::fromErrors(samples, 10.0, 5, 0.0);
+  ASSERT_NEAR(poor.varianceAt(here), 0.25, 1e-12);
+  std::ofstream(dir / "poor.yaml") << poor.toYaml();
+  const ReplayResult plain = replayAgainstThePairsMap(dir / "scans");
+  const ReplayResult floored = replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "poor.yaml") + "\n");
+  EXPECT_EQ(plain.pipeline_report.ndt_quality_raised, 0u);
+  EXPECT_EQ(floored.pipeline_report.ndt_quality_raised, floored.ndt.poses);
+  ASSERT_EQ(floored.ndt.poses, 3u);
+  int claimed = 0;
+  for (const auto& [key, covariance] : floored.claimedCovariances()) {
+    if (key.first != pipeline::kNdtSource) continue;
+    ++claimed;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> e(covariance);
+    EXPECT_GE(e.eigenvalues().minCoeff(), 0.25 * (1.0 - 1e-9));
+  }
+  EXPECT_EQ(claimed, 3);
+  for (const auto& [key, covariance] : plain.claimedCovariances()) {
+    if (key.first != pipeline::kNdtSource) continue;
+    EXPECT_LT(covariance.trace(), 0.1) << "the fit's own covariance, as before";
+  }
+  // The same poses where the map's only cell lies elsewhere and its default is nothing: as NDT gave them.
+  std::ofstream(dir / "elsewhere.yaml") << pipeline::NdtQualityMap::fromErrors({samples.begin() + 5, samples.end()}, 10.0, 5, 0.0).toYaml();
+  EXPECT_EQ(replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "elsewhere.yaml") + "\n").pipeline_report.ndt_quality_raised, 0u);
+  try {
+    replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "absent.yaml") + "\n");
+    FAIL() << "a quality map that is not there was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("absent.yaml"), std::string::npos) << e.what();
+  }
 }
 
 TEST(LogReplay, ALogsTfStaticPlacesTheLidarWhereTheConfigDoesNot) {

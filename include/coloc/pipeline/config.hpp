@@ -66,6 +66,9 @@ struct NdtSection {
   /// live, the LiDAR is at the vehicle's origin.
   bool lidar_pose_given = false;
   std::string base_frame = "base_link";  ///< the vehicle's frame in /tf_static, whose pose the filter estimates
+  /// NDT's mean square error by place (NdtQualityMap's file, relative to the config file); each NDT
+  /// pose's x/y variance at least its cell's. Empty: none.
+  std::string quality_map;
 };
 
 /// Roadside fixes: which RSUs are trusted and how fresh a fix must be.

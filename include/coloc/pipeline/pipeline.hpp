@@ -87,6 +87,8 @@ struct PipelineReport {
   /// covariance widened by the excess), and the largest excess, m.
   std::uint64_t ndt_fix_disagreements = 0;
   double ndt_fix_max_excess = 0.0;
+  /// NDT poses whose x/y variance ndt.quality_map raised to their place's figure.
+  std::uint64_t ndt_quality_raised = 0;
   std::uint64_t rejections = 0;              ///< every refusal, of any kind
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };

@@ -5,6 +5,7 @@
 
 #include "coloc/core/types.hpp"
 #include "coloc/io/trajectory_file.hpp"
+#include "coloc/pipeline/ndt_quality_map.hpp"
 
 namespace coloc::replay {
 
@@ -69,6 +70,11 @@ struct InputComparison {
   double mean_square_xy = 0.0, yaw_variance = 0.0;
   double yaw_mean = 0.0;  ///< rad
 };
+
+/// NDT's error by place from its poses on a drive with ground truth (each at NDT's own position, as a
+/// vehicle looks it up, with its x/y error): cells of `cell` m holding at least `min_poses` poses, and
+/// elsewhere the drive's own mean square (x and y pooled). What ndt.quality_map reads.
+pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, double cell = 10.0, std::size_t min_poses = 5);
 
 /// The three pair by stamp (a stamp missing from any of them is left out).
 InputComparison compareWithInput(const std::vector<ErrorSample>& input, const std::vector<ErrorSample>& fused_at_input,

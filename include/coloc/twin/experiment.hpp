@@ -89,6 +89,8 @@ struct ExperimentResults {
   std::map<std::string, Eigen::Vector2d> estimated_twist_variance;
   /// Per site: NDT's mean square error per axis on that drive, x/y (m^2) and yaw (rad^2), when estimated.
   std::map<std::string, Eigen::Vector2d> estimated_ndt_variance;
+  /// Per site: the cells of NDT's error by place measured on that drive (ExperimentConfig::ndt_quality_by_place).
+  std::map<std::string, std::size_t> ndt_quality_cells;
   std::vector<CalibrationResult> calibrations;
   /// Each RSU's survey and clock error as drawn and as its commissioning on the noise calibration
   /// drive found it (when `calibrate_rsus`).

@@ -56,6 +56,11 @@ struct ExperimentConfig {
   /// `multi_ndt_score`, the default, trusts NDT as measured where its score holds it and not along a
   /// direction where the score is flat (docs/experiment.md, "The filter against its best input").
   NdtCovarianceSource ndt_covariance = NdtCovarianceSource::kMultiNdtScore;
+  /// With multi_ndt_score: NDT's error measured by place on the site's noise calibration drive (10 m
+  /// cells, pipeline::NdtQualityMap, `ndt.quality_map`) floors each pose where it is, instead of the
+  /// drive's one figure for the whole site, which hid NDT's good matches where the rest of the site
+  /// is poor (`ndt_quality_map: by_place | site`).
+  bool ndt_quality_by_place = true;
   /// Estimated by default: with the fixes carried to their tick (fusion.pose_time_alignment) the
   /// filter can trust them as much as they deserve; Table I shows the paper's figures beside it.
   RsuCovariance rsu_covariance = RsuCovariance::kEstimated;

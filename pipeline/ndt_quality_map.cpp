@@ -1,0 +1,87 @@
+#include "coloc/pipeline/ndt_quality_map.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "coloc/core/error.hpp"
+#include "coloc/core/yaml_reader.hpp"
+
+namespace coloc::pipeline {
+
+namespace {
+// Cells of 1-1000 m over maps of up to +-1e9 m: their indices fit in a long long with room to spare.
+constexpr double kMinCell = 1.0, kMaxCell = 1000.0, kMaxVariance = 1e6, kMaxCoordinate = 1e9;
+}  // namespace
+
+std::pair<long long, long long> NdtQualityMap::indexOf(const Eigen::Vector2d& xy) const {
+  return {static_cast<long long>(std::floor(xy.x() / cell_)), static_cast<long long>(std::floor(xy.y() / cell_))};
+}
+
+NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples, double default_variance) {
+  if (!(cell >= kMinCell && cell <= kMaxCell)) throw Error("NDT quality map: the cell must be " + std::to_string(kMinCell) + "-" + std::to_string(kMaxCell) + " m");
+  if (!(default_variance >= 0.0 && default_variance <= kMaxVariance)) throw Error("NDT quality map: the default variance must be a finite number of m^2 >= 0");
+  NdtQualityMap map;
+  map.cell_ = cell;
+  map.default_variance_ = default_variance;
+  std::map<std::pair<long long, long long>, std::pair<double, std::size_t>> sums;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const NdtQualitySample& s = samples[i];
+    if (!s.position.allFinite() || !s.error.allFinite() || s.position.cwiseAbs().maxCoeff() > kMaxCoordinate)
+      throw Error("NDT quality map: sample " + std::to_string(i) + " is not finite or lies beyond 1e9 m");
+    auto& sum = sums[map.indexOf(s.position)];
+    sum.first += 0.5 * s.error.squaredNorm();  // x and y pooled
+    ++sum.second;
+  }
+  for (const auto& [index, sum] : sums)
+    if (sum.second >= std::max<std::size_t>(min_samples, 1)) map.cells_[index] = {sum.first / static_cast<double>(sum.second), sum.second};
+  return map;
+}
+
+double NdtQualityMap::varianceAt(const Eigen::Vector2d& xy) const {
+  if (cells_.empty() || !xy.allFinite() || xy.cwiseAbs().maxCoeff() > kMaxCoordinate) return default_variance_;
+  const auto found = cells_.find(indexOf(xy));
+  return found == cells_.end() ? default_variance_ : found->second.variance;
+}
+
+std::string NdtQualityMap::toYaml() const {
+  std::ostringstream out;
+  out << std::setprecision(17);
+  out << "# coloc NDT quality map: NDT's mean square x/y error (m^2) per cell of the map, from a drive with a reference.\n"
+      << "# Each NDT pose's x/y variance is held at least at its cell's (ndt.quality_map).\n"
+      << "cell: " << cell_ << "  # m; cell [i, j] spans x in [i, i + 1) * cell, y in [j, j + 1) * cell\n"
+      << "default_variance: " << default_variance_ << "  # m^2, where no cell is listed\n"
+      << "cells:  # [i, j, poses, variance]\n";
+  if (cells_.empty()) out << "  []\n";
+  for (const auto& [index, c] : cells_) out << "  - [" << index.first << ", " << index.second << ", " << c.samples << ", " << c.variance << "]\n";
+  return out.str();
+}
+
+NdtQualityMap NdtQualityMap::parse(const std::string& text, const std::string& source) {
+  const YamlReader r(source);
+  const YAML::Node root = r.parse(text);
+  if (!root.IsMap()) r.fail(root, "(top level)", "expected a mapping with cell, default_variance and cells");
+  r.allowKeys(root, "(top level)", {"cell", "default_variance", "cells"});
+  NdtQualityMap map;
+  map.cell_ = r.inRange(r.require(root, "cell", "(top level)"), "cell", kMinCell, kMaxCell);
+  map.default_variance_ = r.inRange(r.require(root, "default_variance", "(top level)"), "default_variance", 0.0, kMaxVariance);
+  const YAML::Node cells = r.require(root, "cells", "(top level)");
+  if (!cells.IsSequence()) r.fail(cells, "cells", "expected a list of [i, j, poses, variance]");
+  const long long reach = static_cast<long long>(kMaxCoordinate / map.cell_) + 1;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const std::string key = "cells[" + std::to_string(i) + "]";
+    const std::vector<double> v = r.numbers(cells[i], key, 4, "[i, j, poses, variance]");
+    for (int k = 0; k < 3; ++k)
+      if (!(std::isfinite(v[k]) && v[k] == std::floor(v[k]) && std::abs(v[k]) <= static_cast<double>(reach)))
+        r.fail(cells[i], key, "i, j and poses must be whole numbers, i and j within the map's reach (1e9 m)");
+    if (v[2] < 1.0) r.fail(cells[i], key, "a cell holds at least one pose");
+    if (!(v[3] >= 0.0 && v[3] <= kMaxVariance)) r.fail(cells[i], key, "the variance must be a finite number of m^2 >= 0");
+    const std::pair<long long, long long> index{static_cast<long long>(v[0]), static_cast<long long>(v[1])};
+    if (!map.cells_.emplace(index, Cell{v[3], static_cast<std::size_t>(v[2])}).second) r.fail(cells[i], key, "the cell appears twice");
+  }
+  return map;
+}
+
+NdtQualityMap NdtQualityMap::load(const std::string& path) { return parse(YamlReader::readFile(path, "NDT quality map"), path); }
+
+}  // namespace coloc::pipeline

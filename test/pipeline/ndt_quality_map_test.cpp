@@ -1,0 +1,72 @@
+// NDT's error by place: each cell the mean square of its poses' errors, the default elsewhere, and a
+// file that reads back to the same map or is refused naming the line and key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "coloc/core/error.hpp"
+#include "coloc/pipeline/ndt_quality_map.hpp"
+
+namespace coloc::pipeline {
+namespace {
+
+std::vector<NdtQualitySample> twoPlaces() {
+  std::vector<NdtQualitySample> s;
+  for (int i = 0; i < 6; ++i) s.push_back({{3.0 + i, 4.0}, {0.01, -0.01}});          // cell (0, 0): 1 cm each way
+  for (int i = 0; i < 6; ++i) s.push_back({{25.0, -3.0}, {i % 2 ? 0.2 : -0.2, 0.0}});  // cell (2, -1): 0.2 m along x
+  for (int i = 0; i < 3; ++i) s.push_back({{55.0, 55.0}, {1.0, 1.0}});                // cell (5, 5): too few poses
+  return s;
+}
+
+TEST(NdtQualityMap, EachCellHoldsTheMeanSquareOfItsPosesAndTheDefaultAnswersElsewhere) {
+  const NdtQualityMap m = NdtQualityMap::fromErrors(twoPlaces(), 10.0, 5, 0.004);
+  EXPECT_EQ(m.cells(), 2u);
+  EXPECT_NEAR(m.varianceAt({9.9, 0.1}), 1e-4, 1e-15);   // x and y pooled: (1e-4 + 1e-4) / 2
+  EXPECT_NEAR(m.varianceAt({20.0, -10.0}), 0.02, 1e-15);  // (0.04 + 0) / 2, a bias counted as error
+  EXPECT_EQ(m.varianceAt({55.0, 55.0}), 0.004) << "three poses are too few: the default";
+  EXPECT_EQ(m.varianceAt({-0.1, 5.0}), 0.004) << "just outside a cell";
+  EXPECT_EQ(m.varianceAt({std::nan(""), 0.0}), 0.004);
+  EXPECT_EQ(NdtQualityMap().varianceAt({0.0, 0.0}), 0.0) << "an empty map floors nothing";
+}
+
+TEST(NdtQualityMap, ItsFileReadsBackToTheSameMap) {
+  const NdtQualityMap m = NdtQualityMap::fromErrors(twoPlaces(), 10.0, 5, 0.004);
+  const NdtQualityMap back = NdtQualityMap::parse(m.toYaml(), "q.yaml");
+  EXPECT_EQ(back.cells(), m.cells());
+  EXPECT_EQ(back.cellSize(), m.cellSize());
+  EXPECT_EQ(back.defaultVariance(), m.defaultVariance());
+  for (const Eigen::Vector2d p : {Eigen::Vector2d(5, 5), Eigen::Vector2d(21, -1), Eigen::Vector2d(55, 55)}) EXPECT_EQ(back.varianceAt(p), m.varianceAt(p));
+  EXPECT_EQ(back.toYaml(), m.toYaml());
+}
+
+TEST(NdtQualityMap, AMalformedFileIsAnErrorNamingTheFileLineAndKey) {
+  const auto refused = [](const std::string& text, const std::string& expected) {
+    try {
+      NdtQualityMap::parse(text, "q.yaml");
+      ADD_FAILURE() << "taken: " << text;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("q.yaml"), std::string::npos) << e.what();
+    }
+  };
+  const std::string head = "cell: 10\ndefault_variance: 0.01\n";
+  refused(head + "cells:\n  - [0, 0, 5, -0.1]\n", "cells[0]");
+  refused(head + "cells:\n  - [0, 0, 5, .nan]\n", "cells[0]");
+  refused(head + "cells:\n  - [0, 0, 5, .inf]\n", "cells[0]");
+  refused(head + "cells:\n  - [0.5, 0, 5, 0.1]\n", "cells[0]");
+  refused(head + "cells:\n  - [0, 0, 0, 0.1]\n", "cells[0]");
+  refused(head + "cells:\n  - [0, 0, 5, 0.1]\n  - [0, 0, 7, 0.2]\n", "cells[1]");
+  refused(head + "cells:\n  - [0, 0, 5]\n", "cells[0]");
+  refused(head + "cells: []\nsize: 3\n", "size");
+  refused("cell: 0\ndefault_variance: 0.01\ncells: []\n", "cell");
+  refused("cell: 10\ndefault_variance: -1\ncells: []\n", "default_variance");
+  refused("cell: 10\ncells: []\n", "default_variance");
+  refused("cell: 10\ndefault_variance: 0.01\ncells: [\n", "q.yaml");
+  EXPECT_THROW(NdtQualityMap::load("/nonexistent/q.yaml"), Error);
+  EXPECT_THROW(NdtQualityMap::fromErrors({{{std::nan(""), 0.0}, {0.0, 0.0}}}, 10.0, 1, 0.0), Error);
+  EXPECT_THROW(NdtQualityMap::fromErrors({}, 0.0, 1, 0.0), Error);
+}
+
+}  // namespace
+}  // namespace coloc::pipeline
