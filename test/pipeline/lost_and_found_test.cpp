@@ -164,7 +164,7 @@ TEST(LostAndFound, UnaddressedFixesAreRefusedUnlessTheConfigurationTakesThem) {
     Drive run(accept ? one_vehicle : egoConfig());
     const Stamp t = kStart + kTick;
     run.pipe.pushInitialPose(planarPose(kStart, truthAt(kStart).x(), truthAt(kStart).y(), kHeading), kStart);
-    run.pipe.pushFix({t, "rsu_a", truthAt(t).x(), truthAt(t).y(), std::nullopt, std::nullopt}, t);
+    run.pipe.pushFix({t, "rsu_a", truthAt(t).x(), truthAt(t).y(), std::nullopt, std::nullopt, std::nullopt}, t);
     run.pipe.runUntil(kStart + 10 * kTick);
     const PipelineReport r = run.pipe.report();
     EXPECT_EQ(r.fixes.at("rsu_a").unaddressed, accept ? 0u : 1u);

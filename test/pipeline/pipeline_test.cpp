@@ -86,7 +86,7 @@ TEST(Pipeline, FixesPassTheRegistrysChecksBeforeReachingTheFilter) {
   pipe.onRejection([&](const std::string& line) { rejections.push_back(line); });
   pipe.pushInitialPose(planarPose(kStart, 10.0, 0.0, 0.0), kStart);
   pipe.pushFix(fixAt(kStart + kTick, 100.0, 0.0), kStart + kTick);          // 90 m from the RSU: outside its coverage
-  pipe.pushFix({kStart + kTick, "rsu_x", 10.0, 0.0, std::nullopt, std::nullopt}, kStart + kTick);  // an RSU nobody registered
+  pipe.pushFix({kStart + kTick, "rsu_x", 10.0, 0.0, std::nullopt, std::nullopt, std::nullopt}, kStart + kTick);  // an RSU nobody registered
   pipe.pushFix(fixAt(kStart + 2 * kTick, 10.01, 0.0), kStart + 2 * kTick);  // a good one
   pipe.runUntil(kStart + 10 * kTick);
   const PipelineReport r = pipe.report();

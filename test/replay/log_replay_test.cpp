@@ -559,7 +559,7 @@ TEST(LogReplay, ALogGivenItsScansDecodedGivesEachToItsMessageAndReplaysAsItsFile
       const io::Bytes data = io::encodePointCloud2(cloud);
       bag.write(m.topic, m.log_time, data.data(), data.size());
       messages.push_back(m);
-      decoded.push_back({cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud))});
+      decoded.push_back({cloud.header.stamp, std::make_shared<const ndt::PointCloud>(pipeline::toPointCloud(cloud)), std::string()});
     }
     bag.close();
   }
