@@ -47,12 +47,14 @@ void BM_CastPackets(benchmark::State& state) {
 }
 
 // A whole sweep of the VLP-32C from the street's sensor position through sim::castSweep, without a
-// footprint (argument 0) and with Velodyne's 3 mrad (argument 3): what the footprint's edge samples
-// cost, as a ratio of the two in the same run.
+// footprint (arguments 0, 0), with Velodyne's 3 mrad across the scan (3, 0), and with its 1.5 mrad up
+// and down as well (3, 15; tenths of a mrad): what the footprint's edge samples cost, as ratios in the
+// same run.
 void BM_CastSweepFootprint(benchmark::State& state) {
   coloc::sim::LidarSpec spec = coloc::sim::vlp32c();
   spec.max_range = 120.0;
   spec.beam_divergence = 1e-3 * static_cast<double>(state.range(0));
+  spec.beam_divergence_vertical = 1e-4 * static_cast<double>(state.range(1));
   const Eigen::Vector3d sensor = street().origins.front().cast<double>();
   const coloc::sim::SensorTrajectory pose = [sensor](double) { return Eigen::Isometry3d(Eigen::Translation3d(sensor)); };
   std::vector<RayHit> hits;
@@ -60,7 +62,7 @@ void BM_CastSweepFootprint(benchmark::State& state) {
   std::size_t edges = 0;  // rays whose return the footprint changed
   const std::vector<RayHit> plain = [&] {
     coloc::sim::LidarSpec without = spec;
-    without.beam_divergence = 0.0;
+    without.beam_divergence = without.beam_divergence_vertical = 0.0;
     return coloc::sim::castSweep(without, street().world, pose);
   }();
   for (std::size_t i = 0; i < hits.size(); ++i) edges += hits[i].distance != plain[i].distance ? 1 : 0;
@@ -114,7 +116,7 @@ void BM_RandomNumbers(benchmark::State& state) {
 
 BENCHMARK(BM_CastOneByOne)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_CastPackets)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK(BM_CastSweepFootprint)->Arg(0)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_CastSweepFootprint)->Args({0, 0})->Args({3, 0})->Args({3, 15})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_SweepNoiseStandardLibrary)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_SweepNoise)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_TEMPLATE(BM_RandomNumbers, std::mt19937_64)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

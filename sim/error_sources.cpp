@@ -18,6 +18,7 @@ ErrorSources ErrorSources::ideal() {
   e.map_yaw_sd = 0.0;
   e.cam_size_step = 0.0;
   e.beam_divergence = 0.0;
+  e.beam_divergence_vertical = 0.0;
   return e;
 }
 

@@ -57,6 +57,7 @@ LidarSpec withErrors(LidarSpec spec, const ErrorSources& errors) {
   spec.dropout = errors.dropout;
   spec.dropout_at_max_range = errors.dropout_at_max_range;
   spec.beam_divergence = errors.beam_divergence;
+  spec.beam_divergence_vertical = errors.beam_divergence_vertical;
   return spec;
 }
 
@@ -129,14 +130,81 @@ class PolarPairs {
   double x_ = 0.0, y_ = 0.0, r2_ = 1.0, scale_ = 0.0;
 };
 
+// What a footprint of three equal parts returns: samples within `separation` of each other make one
+// echo at their mean range (mixed pixels), and the echo returned is the strongest, the share of the
+// footprint it covers over its range squared (the same reflectivity assumed); nothing if none hit.
+RayHit strongestEcho(RayHit (&samples)[3], double separation) {
+  std::sort(std::begin(samples), std::end(samples), [](const RayHit& a, const RayHit& b) {
+    return (a.distance >= 0.0f) != (b.distance >= 0.0f) ? a.distance >= 0.0f : a.distance < b.distance;
+  });
+  RayHit best;
+  double best_energy = 0.0;
+  for (int first = 0; first < 3 && samples[first].distance >= 0.0f;) {
+    int last = first;
+    double sum = 0.0;
+    while (last < 3 && samples[last].distance >= 0.0f && samples[last].distance - samples[first].distance <= separation) sum += samples[last++].distance;
+    const double range = sum / (last - first);
+    const double energy = (last - first) / (range * range);
+    if (energy > best_energy) best_energy = energy, best = {static_cast<float>(range), samples[first].mesh};
+    first = last;
+  }
+  return best;
+}
+
+// The rays of a sweep at edges and the thirds of their footprints to cast, towards the neighbour that
+// differs on either side (side 1: before or below, side 2: after or above); reused between sweeps.
+class EdgeSamples {
+ public:
+  void clear() {
+    edges_.clear();
+    origins_.clear();
+    directions_.clear();
+  }
+  /// `toward(sign)`: the direction of the third towards side 1 (sign -1) or side 2 (+1).
+  template <typename Toward>
+  void add(std::size_t ray, int sides, const Eigen::Vector3f& origin, Toward toward) {
+    edges_.push_back({ray, sides, directions_.size()});
+    for (int k = 1; k <= 2; ++k) {
+      if (!(sides & k)) continue;
+      origins_.push_back(origin);
+      directions_.push_back(toward(k == 1 ? -1.0 : 1.0));
+    }
+  }
+  /// Casts the thirds and gives each edge ray strongestEcho of its return and theirs; a third for which
+  /// `counts(ray, hit)` is false is the centre's surface going on.
+  template <typename Counts>
+  void resolve(const LidarSpec& spec, const RayCaster& world, std::vector<RayHit>& hits, Counts counts) {
+    if (edges_.empty()) return;
+    world.cast(origins_, directions_, static_cast<float>(spec.max_range), hits_);
+    for (const Edge& e : edges_) {
+      RayHit samples[3] = {hits[e.ray], hits[e.ray], hits[e.ray]};
+      std::size_t next = e.first;
+      for (int k = 1; k <= 2; ++k) {
+        if (!(e.sides & k)) continue;
+        const RayHit& third = hits_[next++];
+        if (counts(e.ray, third)) samples[k] = third;
+      }
+      hits[e.ray] = strongestEcho(samples, spec.echo_separation);
+    }
+  }
+
+ private:
+  struct Edge {
+    std::size_t ray;
+    int sides;
+    std::size_t first;  ///< its first third among the casts
+  };
+  std::vector<Edge> edges_;
+  std::vector<Eigen::Vector3f> origins_, directions_;
+  std::vector<RayHit> hits_;
+};
+
 // The returns where a footprint straddles a depth edge. A ray is at an edge when the same laser's
 // neighbouring firing hit something where it hit nothing, or something 0.1 m nearer or farther than a
 // surface going on evenly would put it. The footprint is taken in three equal parts across the scan:
 // the centre ray's, and on each side of such a neighbour a ray a third of the divergence towards it (on
-// a side without one, the centre's surface goes on). Samples within echo_separation of each other make
-// one echo at their mean range (mixed pixels), and the echo returned is the strongest: the share of the
-// footprint it covers over its range squared, the same reflectivity assumed. Only the rays at edges are
-// cast again.
+// a side without one, the centre's surface goes on); the echo returned is strongestEcho's. Only the
+// rays at edges are cast again.
 void footprintsAtEdges(const LidarSpec& spec, const RayCaster& world, const std::vector<Eigen::Vector3d>& local, const std::vector<Eigen::Matrix3d>& turns,
                        const std::vector<Eigen::Vector3f>& origins, std::vector<RayHit>& hits) {
   const int lasers = static_cast<int>(spec.vertical_deg.size());
@@ -153,17 +221,8 @@ void footprintsAtEdges(const LidarSpec& spec, const RayCaster& world, const std:
     if (other.distance >= 0.0f && std::abs(step - (centre.distance - other.distance)) <= 0.1f) return false;
     return step < -0.1f || (step > 0.1f && step <= separation);
   };
-  struct Edge {
-    std::size_t ray;
-    int sides;  ///< bit 0: a sample towards the firing before, bit 1: towards the one after
-    std::size_t first;  ///< its first sample among the casts
-  };
-  thread_local std::vector<Edge> edges;
-  thread_local std::vector<Eigen::Vector3f> sub_origins, sub_directions;
-  thread_local std::vector<RayHit> sub_hits;
+  thread_local EdgeSamples edges;
   edges.clear();
-  sub_origins.clear();
-  sub_directions.clear();
   // The firings' azimuth grows with f: the one before lies at a smaller angle about the sensor's z.
   const double side = spec.beam_divergence / 3.0;
   const double c = std::cos(side), s = std::sin(side);
@@ -174,39 +233,63 @@ void footprintsAtEdges(const LidarSpec& spec, const RayCaster& world, const std:
       const std::size_t after = static_cast<std::size_t>(((f + 1) % firings) * lasers + l);
       const int sides = (differs(hits[i], hits[before], hits[after]) ? 1 : 0) | (differs(hits[i], hits[after], hits[before]) ? 2 : 0);
       if (!sides) continue;
-      edges.push_back({i, sides, sub_directions.size()});
       const Eigen::Vector3d& d = local[i];
-      for (const double sign : {-1.0, 1.0}) {
-        if (!(sides & (sign < 0.0 ? 1 : 2))) continue;
+      edges.add(i, sides, origins[i], [&](double sign) {
         const Eigen::Vector3d turned(c * d.x() - sign * s * d.y(), sign * s * d.x() + c * d.y(), d.z());
-        sub_origins.push_back(origins[i]);
-        sub_directions.push_back((turns[static_cast<std::size_t>(f)] * turned).normalized().cast<float>());
-      }
+        return (turns[static_cast<std::size_t>(f)] * turned).normalized().cast<float>().eval();
+      });
     }
-  if (edges.empty()) return;
-  world.cast(sub_origins, sub_directions, static_cast<float>(spec.max_range), sub_hits);
-  for (const Edge& e : edges) {
-    RayHit samples[3] = {hits[e.ray], hits[e.ray], hits[e.ray]};
-    std::size_t next = e.first;
-    if (e.sides & 1) samples[1] = sub_hits[next++];
-    if (e.sides & 2) samples[2] = sub_hits[next++];
-    std::sort(std::begin(samples), std::end(samples), [](const RayHit& a, const RayHit& b) {
-      return (a.distance >= 0.0f) != (b.distance >= 0.0f) ? a.distance >= 0.0f : a.distance < b.distance;
-    });
-    RayHit best;
-    double best_energy = 0.0;
-    for (int first = 0; first < 3 && samples[first].distance >= 0.0f;) {
-      int last = first;
-      double sum = 0.0;
-      while (last < 3 && samples[last].distance >= 0.0f && samples[last].distance - samples[first].distance <= spec.echo_separation)
-        sum += samples[last++].distance;
-      const double range = sum / (last - first);
-      const double energy = (last - first) / (range * range);
-      if (energy > best_energy) best_energy = energy, best = {static_cast<float>(range), samples[first].mesh};
-      first = last;
-    }
-    hits[e.ray] = best;
+  edges.resolve(spec, world, hits, [](std::size_t, const RayHit&) { return true; });
+}
+
+// The same up and down, between objects one above the other: a ray is at such an edge when the laser
+// next to it in elevation, in the same firing, hit another object (another mesh) nearer, or farther
+// by less than echo_separation (a car's sill over the road under it, seen from a pole; from a low mast
+// the road lies farther behind and is told apart). Within one object the surface goes on (a road's
+// rings of returns step by metres and are no edge). Run after the footprint across the scan, on its
+// returns; the thirds of the footprint up and down are cast from the centre ray's direction.
+void verticalFootprintsAtEdges(const LidarSpec& spec, const RayCaster& world, const std::vector<Eigen::Vector3d>& local,
+                               const std::vector<Eigen::Matrix3d>& turns, const std::vector<Eigen::Vector3f>& origins,
+                               const std::vector<RayHit>& centre_hits, std::vector<RayHit>& hits) {
+  const int lasers = static_cast<int>(spec.vertical_deg.size());
+  const int firings = firingsPerSweep(spec);
+  // Each laser's neighbours in elevation (-1: none).
+  std::vector<int> order(static_cast<std::size_t>(lasers)), below(static_cast<std::size_t>(lasers), -1), above(static_cast<std::size_t>(lasers), -1);
+  for (int l = 0; l < lasers; ++l) order[static_cast<std::size_t>(l)] = l;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return spec.vertical_deg[static_cast<std::size_t>(a)] < spec.vertical_deg[static_cast<std::size_t>(b)]; });
+  for (std::size_t k = 0; k + 1 < order.size(); ++k) {
+    above[static_cast<std::size_t>(order[k])] = order[k + 1];
+    below[static_cast<std::size_t>(order[k + 1])] = order[k];
   }
+  const float separation = static_cast<float>(spec.echo_separation);
+  const auto differs = [separation](const RayHit& centre, const RayHit& neighbour) {
+    if (neighbour.distance < 0.0f) return false;
+    if (centre.distance < 0.0f) return true;
+    if (neighbour.mesh == centre.mesh) return false;
+    const float step = neighbour.distance - centre.distance;
+    return step < -0.1f || (step > 0.1f && step <= separation);
+  };
+  thread_local EdgeSamples edges;
+  edges.clear();
+  const double side = spec.beam_divergence_vertical / 3.0;
+  for (int f = 0; f < firings; ++f)
+    for (int l = 0; l < lasers; ++l) {
+      const std::size_t i = static_cast<std::size_t>(f * lasers + l);
+      const int lo = below[static_cast<std::size_t>(l)], hi = above[static_cast<std::size_t>(l)];
+      const int sides = (lo >= 0 && differs(centre_hits[i], centre_hits[static_cast<std::size_t>(f * lasers + lo)]) ? 1 : 0) |
+                        (hi >= 0 && differs(centre_hits[i], centre_hits[static_cast<std::size_t>(f * lasers + hi)]) ? 2 : 0);
+      if (!sides) continue;
+      const Eigen::Vector3d& d = local[i];
+      const double azimuth = std::atan2(d.y(), d.x()), elevation = std::asin(std::clamp(d.z(), -1.0, 1.0));
+      edges.add(i, sides, origins[i], [&](double sign) {
+        const double e = elevation + sign * side;
+        const Eigen::Vector3d turned(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth), std::sin(e));
+        return (turns[static_cast<std::size_t>(f)] * turned).normalized().cast<float>().eval();
+      });
+    }
+  // A third on the centre's own object is the centre's surface going on (a road seen at a grazing
+  // angle spreads its echo over a few decimetres about the centre's range; the sensor reports that).
+  edges.resolve(spec, world, hits, [&](std::size_t ray, const RayHit& third) { return third.distance < 0.0f || third.mesh != centre_hits[ray].mesh; });
 }
 
 }  // namespace
@@ -242,7 +325,16 @@ void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajec
     }
   }
   world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
-  if (spec.beam_divergence > 0.0) footprintsAtEdges(spec, world, local, turns, origins, hits);
+  if (spec.beam_divergence_vertical > 0.0) {
+    // Edges up and down are found on the centre rays' hits, before the footprint across the scan
+    // changes them.
+    thread_local std::vector<RayHit> centre;
+    centre = hits;
+    if (spec.beam_divergence > 0.0) footprintsAtEdges(spec, world, local, turns, origins, hits);
+    verticalFootprintsAtEdges(spec, world, local, turns, origins, centre, hits);
+  } else if (spec.beam_divergence > 0.0) {
+    footprintsAtEdges(spec, world, local, turns, origins, hits);
+  }
 }
 
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng) {

@@ -27,7 +27,7 @@ std::uint64_t sweepFingerprint(const LidarSpec& spec, const SensorTrajectory& po
   if (count > 0) mix(h, world, count * sizeof(double));
   mix(h, spec.vertical_deg.data(), spec.vertical_deg.size() * sizeof(double));
   mix(h, spec.azimuth_offset_deg.data(), spec.azimuth_offset_deg.size() * sizeof(double));
-  for (double v : {spec.rotation_hz, spec.azimuth_step_deg, spec.max_range, spec.beam_divergence, spec.echo_separation}) mix(h, &v, sizeof v);
+  for (double v : {spec.rotation_hz, spec.azimuth_step_deg, spec.max_range, spec.beam_divergence, spec.beam_divergence_vertical, spec.echo_separation}) mix(h, &v, sizeof v);
   const int firings = firingsPerSweep(spec);
   const double sweep = 1.0 / spec.rotation_hz;
   for (int f = 0; f < firings; ++f) {

@@ -175,6 +175,42 @@ TEST(LidarModel, AFootprintAcrossAnEdgeReturnsTheStrongerEchoOrAMixedRange) {
   EXPECT_NEAR(firingAtAnEdge(divergence, 20.0, -0.5e-3).distance, 20.0, 0.01);
 }
 
+// Three lasers 1 deg apart, their footprint `divergence` up and down.
+LidarSpec threeLasers(double divergence) {
+  const LidarSpec spec = threeLasers(divergence);
+  return spec;
+}
+
+// Three lasers 1 deg apart, firing 0 straight along x; a wall 40 m ahead and, nearer, another object
+// whose lower edge (a car's sill) lies `edge` rad above the middle laser's centre ray, at `near` m. The
+// middle laser's return.
+RayHit firingUnderAnEdge(double divergence, double near, double edge) {
+  RayCaster world;
+  world.addMesh(box({40.0f, 0.0f, -5.0f}, {0.2f, 40.0f, 10.0f}));
+  const float z0 = static_cast<float>(near * std::tan(edge));
+  world.addMesh(box({static_cast<float>(near) + 0.1f, 0.0f, z0}, {0.2f, 40.0f, 10.0f}));
+  world.commit();
+  const LidarSpec spec = threeLasers(divergence);
+  return castSweep(spec, world, [](double) { return Eigen::Isometry3d::Identity(); })[1];
+}
+
+// The footprint up and down (Velodyne: 1.5 mrad): where a laser's centre passes just under an object
+// that the laser above hits, a third of the footprint on it outshines the far wall, or merges with a
+// surface less than a pulse behind. A surface that goes on (the same object) is no edge.
+TEST(LidarModel, AFootprintUnderAnEdgeAboveReturnsTheStrongerEchoOrAMixedRange) {
+  const double divergence = 1.5e-3;
+  EXPECT_NEAR(firingUnderAnEdge(0.0, 20.0, 0.4e-3).distance, 39.9, 0.01) << "without divergence: the wall";
+  EXPECT_NEAR(firingUnderAnEdge(divergence, 20.0, 0.4e-3).distance, 20.0, 0.01) << "a third on the object at 20 m";
+  EXPECT_NEAR(firingUnderAnEdge(divergence, 20.0, 0.6e-3).distance, 39.9, 0.01) << "the edge beyond the footprint's upper third";
+  EXPECT_NEAR(firingUnderAnEdge(divergence, 39.6, 0.4e-3).distance, (39.6 + 2 * 39.9) / 3.0, 0.01) << "a mixed pixel";
+  // Only the wall: the three lasers hit the same object, and the middle one's return is its centre's.
+  RayCaster wall;
+  wall.addMesh(box({40.0f, 0.0f, -5.0f}, {0.2f, 40.0f, 10.0f}));
+  wall.commit();
+  const LidarSpec spec = threeLasers(divergence);
+  EXPECT_NEAR(castSweep(spec, wall, [](double) { return Eigen::Isometry3d::Identity(); })[1].distance, 39.9, 1e-4);
+}
+
 #if defined(__GLIBCXX__)
 // The twin's results were made with libstdc++'s std::normal_distribution and uniform draws, two per ray
 // in ray order, hit or not; the sweep's own draws (whose log is skipped for rays that return nothing)

@@ -92,6 +92,8 @@ TEST(Scenario, UnstatedRsuSurveyAndClockErrorsAreDrawnOncePerInstallationFromThe
   EXPECT_DOUBLE_EQ(parseScenario(std::string(kRoute) + "errors: {beam_divergence_mrad: 1.5}\n", "s.yaml").errors.beam_divergence, 1.5e-3);
   expectError(std::string(kRoute) + "errors: {beam_divergence_mrad: -1}\n", "errors.beam_divergence_mrad: must be in [0, 20]");
   expectError(std::string(kRoute) + "errors: {beam_divergence_mrad: .nan}\n", "errors.beam_divergence_mrad: must not be NaN");
+  EXPECT_DOUBLE_EQ(parseScenario(std::string(kRoute) + "errors: {beam_divergence_vertical_mrad: 0.7}\n", "s.yaml").errors.beam_divergence_vertical, 0.7e-3);
+  expectError(std::string(kRoute) + "errors: {beam_divergence_vertical_mrad: 25}\n", "errors.beam_divergence_vertical_mrad: must be in [0, 20]");
   expectError(std::string(kRoute) + "errors: {fog: 1}\n", "errors.fog: unknown key");
   expectError(std::string(kRoute) + "errors: {dropout: 1.5}\n", "errors.dropout");
   expectError(std::string(kRoute) + "errors: {vehicle_body: blob}\n", "errors.vehicle_body: expected one of detailed, boxes");

@@ -32,11 +32,14 @@ struct LidarSpec {
   /// returned (the sensor's default mode: a near edge covering part of the footprint blooms outwards).
   /// 0: each return is its centre ray's.
   double beam_divergence = 0.0;
+  /// The same up and down (rad; Velodyne: 1.5 mrad). Its edges run between two objects one above the
+  /// other: a car's sill against the road under it, its roof line against what lies behind. 0: none.
+  double beam_divergence_vertical = 0.0;
   double echo_separation = 0.5;  ///< m; a pulse of a few ns, our estimate
 };
 
 /// Velodyne's published calibration (ros-drivers/velodyne VLP16db.yaml, VeloView-VLP-32C.yaml).
-/// Their beam divergence is set by withErrors (ErrorSources::beam_divergence).
+/// Their beam divergence is set by withErrors (ErrorSources::beam_divergence and beam_divergence_vertical).
 LidarSpec vlp16();
 LidarSpec vlp32c();
 /// A 64-beam LiDAR with evenly spread beams (45 deg vertical, 1024 columns), as on roadside poles; an
