@@ -177,7 +177,11 @@ TEST(LidarModel, AFootprintAcrossAnEdgeReturnsTheStrongerEchoOrAMixedRange) {
 
 // Three lasers 1 deg apart, their footprint `divergence` up and down.
 LidarSpec threeLasers(double divergence) {
-  const LidarSpec spec = threeLasers(divergence);
+  LidarSpec spec;
+  spec.name = "three lasers";
+  spec.vertical_deg = {-1.0, 0.0, 1.0};
+  spec.azimuth_offset_deg = {0.0, 0.0, 0.0};
+  spec.beam_divergence_vertical = divergence;
   return spec;
 }
 
