@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "coloc/core/error.hpp"
+#include "coloc/fusion/verdict.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/replay/svg_plot.hpp"
 
@@ -450,6 +451,48 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
           ndt_md << "- | - | - | - |\n";
       }
       writeFile(out_dir + "/ndt_vs_fused.csv", csv.str());
+    }
+    // NDT's normalized innovation squared per site and configuration, the main drives' ideal network.
+    std::map<std::pair<std::string, std::string>, std::pair<double, std::uint64_t>> nis;
+    std::vector<std::string> configurations;  // NDT only first, then each LiDAR as configured
+    for (const std::string& name : [&] {
+           std::vector<std::string> all = {"NDT only"};
+           for (const std::string& lidar : c.lidars) all.push_back("NDT + " + lidar);
+           return all;
+         }())
+      for (const ExperimentRun& r : results.runs)
+        if (name == (r.lidar.empty() ? "NDT only" : "NDT + " + r.lidar) && r.ndt_nis_dof > 0) {
+          configurations.push_back(name);
+          break;
+        }
+    for (const ExperimentRun& r : results.runs) {
+      if (!r.variant.empty() || r.delay != 0.0 || r.loss != 0.0 || r.ndt_nis_dof == 0) continue;
+      auto& n = nis[{r.site, r.lidar.empty() ? "NDT only" : "NDT + " + r.lidar}];
+      n.first += r.ndt_nis_sum;
+      n.second += r.ndt_nis_dof;
+    }
+    if (!nis.empty()) {
+      ndt_md << "\n**NDT's normalized innovation squared** per degree of freedom in the filter (d^2 = e' (H P H' + R)^-1 e at its "
+                "first use; 1 when the filter's and NDT's covariances are honest), the main drives on the ideal network, each with "
+                "the band it lies in 95 % of the time when they are:\n\n| site |";
+      for (const std::string& configuration : configurations) ndt_md << " " << configuration << " |";
+      ndt_md << "\n|---|";
+      for (std::size_t k = 0; k < configurations.size(); ++k) ndt_md << "---|";
+      ndt_md << "\n";
+      for (const SiteInfo& site : results.sites) {
+        ndt_md << "| " << site.name << " |";
+        for (const std::string& configuration : configurations) {
+          const auto found = nis.find({site.name, configuration});
+          if (found == nis.end()) {
+            ndt_md << " - |";
+            continue;
+          }
+          const auto band = fusion::nisBand(found->second.second);
+          ndt_md << fmt(" %.2f", found->second.first / static_cast<double>(found->second.second)) << fmt(" (%.2f-", band.first)
+                 << fmt("%.2f) |", band.second);
+        }
+        ndt_md << "\n";
+      }
     }
   }
 

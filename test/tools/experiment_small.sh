@@ -68,4 +68,10 @@ expected=$(awk -F, 'NR > 1 && $1 == "small_site" && $(NF-12) == "VLP-32C" && $(N
          }' "$work/out/runs.csv")
 row=$(grep '^| small_site | VLP-32C | [0-9.]* cm | ' "$work/out/README.md")
 echo "$row" | grep -qF "$expected" || { echo "FAIL: the per-site row '$row' does not carry the trials' standard error $expected"; exit 1; }
-echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected"
+# NDT's normalized innovation squared per site and configuration, each beside its 95 % band, whose
+# bounds straddle 1.
+nis=$(grep -A4 "NDT's normalized innovation squared" "$work/out/README.md" | grep '^| small_site |') ||
+  { echo "FAIL: no row of NDT's normalized innovation squared for the site"; exit 1; }
+echo "$nis" | grep -qE '^\| small_site( \| [0-9]+\.[0-9]+ \((0\.[0-9]+)-(1\.[0-9]+)\))+ \|$' ||
+  { echo "FAIL: the NIS row '$nis' is not each configuration's figure and band"; exit 1; }
+echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected; NDT's NIS: $nis"

@@ -33,6 +33,10 @@ struct ExperimentRun {
   double replay_seconds = 0.0;
   /// NDT's own poses beside the fused pose at their stamps (never worse than the best input?).
   replay::InputComparison ndt;
+  /// NDT's normalized innovation squared in the filter: d^2 summed over its poses, and their degrees of
+  /// freedom (fusion::SourceCounters::nis_sum, nis_dof; the ratio is 1 when the covariances are honest).
+  double ndt_nis_sum = 0.0;
+  std::uint64_t ndt_nis_dof = 0;
 
   std::string label() const;  ///< "NDT only", "NDT + VLP-16", "NDT + VLP-16, 30 ms, 20 % loss"
 };
