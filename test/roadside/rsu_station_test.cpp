@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "coloc/core/error.hpp"
 #include "coloc/roadside/rsu_station.hpp"
@@ -260,6 +263,23 @@ TEST_F(Station, CommissionedFromASurveyedEmptyFrameItFixesFromTheFirstFrames) {
     EXPECT_LT((o[0].detection.position - at(cars[0], t)).norm(), 0.15);
   }
   EXPECT_EQ(station.counters().commissioning_frames, 1u);
+}
+
+TEST_F(Station, AConfigurationOutOfRangeIsRefusedNamingTheKeys) {
+  for (const auto& [key, change] : std::vector<std::pair<std::string, void (*)(RsuStationConfig&)>>{
+           {"learn_every", [](RsuStationConfig& c) { c.learn_every = 0; }},
+           {"refresh_frames", [](RsuStationConfig& c) { c.refresh_frames = -1; }},
+           {"commissioning_frames", [](RsuStationConfig& c) { c.commissioning_frames = 0; }},
+           {"coverage", [](RsuStationConfig& c) { c.coverage = std::nan(""); }}}) {
+    RsuStationConfig config;
+    change(config);
+    try {
+      RsuStation station(mount_, config);
+      ADD_FAILURE() << key << " out of range was taken";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST_F(Station, AStaleOrMalformedCamIsNotLookedFor) {

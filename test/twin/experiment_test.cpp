@@ -73,6 +73,10 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
       << errorOf("rsu_background: empty\n");
   EXPECT_NE(errorOf("oracle_fix_limit: -0.02\n").find("exp.yaml:1: oracle_fix_limit: must be in [0, 100]"), std::string::npos)
       << errorOf("oracle_fix_limit: -0.02\n");
+  EXPECT_TRUE(parseExperimentConfig("", "exp.yaml").ndt_quality_by_place);
+  EXPECT_FALSE(parseExperimentConfig("ndt_quality_map: site\n", "exp.yaml").ndt_quality_by_place);
+  EXPECT_NE(errorOf("ndt_quality_map: yes\n").find("exp.yaml:1: ndt_quality_map: expected one of by_place, site"), std::string::npos)
+      << errorOf("ndt_quality_map: yes\n");
 }
 
 TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideIt) {
