@@ -30,17 +30,22 @@ class FixAgreement {
 
   /// The odometry's speed as the filter takes it (its learned scale applied), m/s.
   void addSpeed(Stamp stamp, double speed);
-  /// A fix that passed the registry's checks.
-  void addFix(Stamp stamp, const Eigen::Vector2d& position);
+  /// A fix that passed the registry's checks, with the x/y variance it is taken at (m^2; 0: unknown).
+  void addFix(Stamp stamp, const Eigen::Vector2d& position, double variance = 0.0);
   /// An NDT pose: the fixes' median disagreement with it beyond the tolerance (zero within it);
   /// nullopt with fewer than min_fixes in the window, no odometry, a non-finite pose or the check off.
-  std::optional<Eigen::Vector2d> check(Stamp stamp, const Eigen::Vector2d& position, double yaw);
+  /// `ndt_variance`: what NDT is worth where the pose is (ndt.quality_map; 0: unknown). Known, and the
+  /// fixes' variance known, the excess is NDT's in the share its variance has of the two: an RSU a few
+  /// centimetres off where a drive with a reference found NDT a centimetre good widens NDT by little,
+  /// and where NDT was found poor the fixes' word stands. Unknown, the disagreement is all NDT's.
+  std::optional<Eigen::Vector2d> check(Stamp stamp, const Eigen::Vector2d& position, double yaw, double ndt_variance = 0.0);
   void reset();
 
  private:
   struct Fix {
     Stamp stamp;
     Eigen::Vector2d position;
+    double variance;  ///< m^2; 0: unknown
   };
   FixAgreementConfig config_;
   OdometryIntegral distance_;

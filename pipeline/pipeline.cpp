@@ -511,7 +511,8 @@ struct Pipeline::Impl {
     // another place, and what they would teach about the odometry is not the vehicle's.
     // Where a drive with a reference measured NDT's error (ndt.quality_map), its pose is worth no more
     // than NDT was there, whatever the fit's sharpness says.
-    if (const double place = ndt_quality.varianceAt(pose.pose.position.head<2>()); place > 0.0) {
+    const double place = ndt_quality.varianceAt(pose.pose.position.head<2>());
+    if (place > 0.0) {
       const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
       pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(xy, place);
       if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_raised;
@@ -530,7 +531,7 @@ struct Pipeline::Impl {
       report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
     }
     // Where the roadside's fixes disagree with NDT's position, its pose is worth no more than that.
-    if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), yaw); off && off->squaredNorm() > 0.0) {
+    if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), yaw, place); off && off->squaredNorm() > 0.0) {
       pose.covariance.topLeftCorner<2, 2>() += *off * off->transpose();
       ++report.ndt_fix_disagreements;
       report.ndt_fix_max_excess = std::max(report.ndt_fix_max_excess, off->norm());
@@ -627,7 +628,7 @@ struct Pipeline::Impl {
           v.measurement.pose.position.head<2>() = cam_size.apply(v.measurement.pose.position.head<2>(), rsu->position, heading);
         }
       const fusion::SourceId source = fix_sources.at(fix->fix.rsu_id);
-      fix_agreement.addFix(v.measurement.stamp, v.measurement.pose.position.head<2>());
+      fix_agreement.addFix(v.measurement.stamp, v.measurement.pose.position.head<2>(), 0.5 * v.measurement.covariance.topLeftCorner<2, 2>().trace());
       initializer.addPosition(source_names[source], v.measurement.stamp, v.measurement.pose.position.head<2>(), v.measurement.covariance(0, 0));
       if (!localizer.initialized()) tryStart();
       if (feedPose(source, v.measurement).applied()) check_start = false;  // the roadside agrees: the start is confirmed
