@@ -1,6 +1,7 @@
 #include "coloc/core/yaml_reader.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -22,6 +23,9 @@ std::string shortNumber(double v) {
 std::string YamlReader::readFile(const std::string& path, const std::string& what) {
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot open the " + what);
+  // A folder opens as a stream on Linux and reads as nothing: say what it is, not that it is empty.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not the " + what);
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();

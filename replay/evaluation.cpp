@@ -136,6 +136,9 @@ pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, doubl
   samples.reserve(ndt.size());
   double sum = 0.0;
   for (const ErrorSample& s : ndt) {
+    // A sample the map cannot place (not finite, or beyond the 1e9 m it indexes) says nothing about any place: left out, not an error
+    // that would stop `coloc fuse` after its replay.
+    if (!s.estimate.allFinite() || !s.truth.allFinite() || s.estimate.cwiseAbs().maxCoeff() > 1e9) continue;
     samples.push_back({s.estimate, s.estimate - s.truth});
     sum += 0.5 * samples.back().error.squaredNorm();
   }

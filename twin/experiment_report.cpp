@@ -454,23 +454,19 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     }
     // NDT's normalized innovation squared per site and configuration, the main drives' ideal network.
     std::map<std::pair<std::string, std::string>, std::pair<double, std::uint64_t>> nis;
-    std::vector<std::string> configurations;  // NDT only first, then each LiDAR as configured
-    for (const std::string& name : [&] {
-           std::vector<std::string> all = {"NDT only"};
-           for (const std::string& lidar : c.lidars) all.push_back("NDT + " + lidar);
-           return all;
-         }())
-      for (const ExperimentRun& r : results.runs)
-        if (name == (r.lidar.empty() ? "NDT only" : "NDT + " + r.lidar) && r.ndt_nis_dof > 0) {
-          configurations.push_back(name);
-          break;
-        }
+    std::set<std::string> present;
     for (const ExperimentRun& r : results.runs) {
       if (!r.variant.empty() || r.delay != 0.0 || r.loss != 0.0 || r.ndt_nis_dof == 0) continue;
-      auto& n = nis[{r.site, r.lidar.empty() ? "NDT only" : "NDT + " + r.lidar}];
+      const std::string configuration = r.lidar.empty() ? "NDT only" : "NDT + " + r.lidar;
+      auto& n = nis[{r.site, configuration}];
       n.first += r.ndt_nis_sum;
       n.second += r.ndt_nis_dof;
+      present.insert(configuration);
     }
+    std::vector<std::string> configurations;  // NDT only first, then each LiDAR as configured
+    if (present.count("NDT only")) configurations.push_back("NDT only");
+    for (const std::string& lidar : c.lidars)
+      if (present.count("NDT + " + lidar)) configurations.push_back("NDT + " + lidar);
     if (!nis.empty()) {
       ndt_md << "\n**NDT's normalized innovation squared** per degree of freedom in the filter (d^2 = e' (H P H' + R)^-1 e at its "
                 "first use; 1 when the filter's and NDT's covariances are honest), the main drives on the ideal network, each with "

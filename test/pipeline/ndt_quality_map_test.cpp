@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "coloc/core/error.hpp"
@@ -64,6 +65,12 @@ TEST(NdtQualityMap, AMalformedFileIsAnErrorNamingTheFileLineAndKey) {
   refused("cell: 10\ncells: []\n", "default_variance");
   refused("cell: 10\ndefault_variance: 0.01\ncells: [\n", "q.yaml");
   EXPECT_THROW(NdtQualityMap::load("/nonexistent/q.yaml"), Error);
+  try {
+    NdtQualityMap::load(std::filesystem::temp_directory_path().string());
+    ADD_FAILURE() << "a folder was read as a map";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(NdtQualityMap::fromErrors({{{std::nan(""), 0.0}, {0.0, 0.0}}}, 10.0, 1, 0.0), Error);
   EXPECT_THROW(NdtQualityMap::fromErrors({}, 0.0, 1, 0.0), Error);
 }

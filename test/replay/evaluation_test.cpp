@@ -185,5 +185,30 @@ TEST(Evaluation, InputErrorCsvPutsTheFiltersOutputAndSettledEstimateBesideEachIn
   for (int column = 12; column < 16; ++column) EXPECT_EQ(rows[1][column], "nan") << column;  // the filter had none at 0.6 s
 }
 
+// NDT's error by place from its poses on a drive: each at NDT's own position with its x/y error; a
+// pose that is not finite places nothing and is left out, and the drive's own mean square answers
+// where no cell has enough poses.
+TEST(Evaluation, NdtQualityMapTakesEachPoseAtNdtsPositionAndLeavesOutWhatCannotBePlaced) {
+  std::vector<ErrorSample> ndt;
+  for (int i = 0; i < 6; ++i) {
+    ErrorSample e{};
+    e.estimate = Eigen::Vector2d(2.0 + i, 3.0);
+    e.truth = e.estimate - Eigen::Vector2d(0.02, 0.0);
+    ndt.push_back(e);
+  }
+  ErrorSample lost{};
+  lost.estimate = Eigen::Vector2d(std::nan(""), 3.0);
+  lost.truth = Eigen::Vector2d(5.0, 3.0);
+  ndt.push_back(lost);
+  ErrorSample far{};
+  far.estimate = Eigen::Vector2d(5e9, 0.0);
+  far.truth = far.estimate;
+  ndt.push_back(far);
+  const pipeline::NdtQualityMap m = ndtQualityMap(ndt, 10.0, 5);
+  EXPECT_EQ(m.cells(), 1u);
+  EXPECT_NEAR(m.varianceAt({5.0, 5.0}), 0.5 * 0.02 * 0.02, 1e-15);
+  EXPECT_NEAR(m.defaultVariance(), 0.5 * 0.02 * 0.02, 1e-15) << "the six poses that could be placed";
+}
+
 }  // namespace
 }  // namespace coloc::replay
