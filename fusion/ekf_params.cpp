@@ -40,6 +40,8 @@ const std::vector<EkfParam>& ekfParams() {
       {"integrity_dead_reckoning_limit", "s", "time without any pose applied that makes the filter degraded; 0 = off", &C::integrity_dead_reckoning_limit},
       {"integrity_anchor_memory", "s", "time of other poses applied after which one gated anchor pose (an outlier) no longer degrades the filter", &C::integrity_anchor_memory},
       {"map_error_sd", "m", "the map's own error against the world (its survey's accuracy, per axis): added to the reported x/y covariance, not the filter's; 0 = the map is the world", &C::map_error_sd},
+      {"map_match_bias_sd", "m", "a bias NDT's poses share from scan to scan (the map's, the place's), as two more states: its stationary sd; the roadside fixes (anchors) tell it apart; 0 = not modelled (Autoware's 6 states)", &C::map_match_bias_sd},
+      {"map_match_bias_length", "m", "travel over which that bias fades to 1/e (a random walk in distance)", &C::map_match_bias_length},
   };
   return params;
 }

@@ -47,8 +47,9 @@ void validate(const EkfConfig& c) {
       {"integrity_lost_min_distance", c.integrity_lost_min_distance},
       {"integrity_dead_reckoning_limit", c.integrity_dead_reckoning_limit},
       {"integrity_anchor_memory", c.integrity_anchor_memory},
-      {"map_error_sd", c.map_error_sd}};
+      {"map_error_sd", c.map_error_sd},                 {"map_match_bias_sd", c.map_match_bias_sd}};
   for (const auto& [key, value] : non_negative) requireConfig(std::isfinite(value) && value >= 0.0, key, "must be finite and >= 0");
+  requireConfig(std::isfinite(c.map_match_bias_length) && c.map_match_bias_length > 0.0, "map_match_bias_length", "must be finite and > 0");
   requireConfig(std::isfinite(c.initial_vx_variance) && c.initial_vx_variance > 0.0, "initial_vx_variance", "must be finite and > 0");
   requireConfig(std::isfinite(c.initial_wz_variance) && c.initial_wz_variance > 0.0, "initial_wz_variance", "must be finite and > 0");
 }
@@ -60,6 +61,7 @@ HistoryOptions historyOptions(const EkfConfig& c) {
   o.noise = {c.proc_stddev_yaw_c, c.proc_stddev_vx_c, c.proc_stddev_wz_c};
   o.aux_proc_dev = {c.z_filter_proc_dev, c.roll_filter_proc_dev, c.pitch_filter_proc_dev};
   o.relinearize = c.relinearize_on_replay;
+  o.bias_length = c.map_match_bias_length;
   return o;
 }
 
@@ -124,7 +126,9 @@ struct Localizer::Impl {
         pose_gate(gateThresholds(c.pose_gate_alpha)),
         twist_gate(gateThresholds(c.twist_gate_alpha)),
         future_tolerance(fromSeconds(c.future_tolerance)),
-        integrity(c) {}
+        integrity(c) {
+    history.setBiasVariance(c.map_match_bias_sd * c.map_match_bias_sd);
+  }
 
   SourceId add(const std::string& name, SourceKind kind, int smoothing_steps = 0, bool anchor = false) {
     if (smoothing_steps < 0) throw Error("source '" + name + "': smoothing_steps must be >= 1 (0: the configuration's), got " + std::to_string(smoothing_steps));
@@ -288,6 +292,21 @@ struct Localizer::Impl {
     }
     for (int a = 0; a < 3; ++a)
       if (r.aux_mask & (1 << a)) s.aux[a] = {r.aux_value[a], r.aux_variance[a], true};
+    if (config.map_match_bias_sd > 0.0) {
+      // The bias is unknown but for its spread at this place; a start from a biased pose (NDT's) knows
+      // the position only as well as the pose and the bias together, and knows their sum exactly as
+      // well as the pose: x = z - b, so x and b start anti-correlated.
+      const double variance = history.biasVariance();
+      s.bias.modelled = true;
+      s.bias.P = Eigen::Matrix2d::Identity() * variance;
+      for (int i = 0; i < r.m && r.biased; ++i) {
+        const int si = r.index[i];
+        if (si != kX && si != kY) continue;
+        s.x[si] -= s.bias.b[si];
+        s.P(si, si) += variance;
+        s.bias.cross(si, si) = -variance;
+      }
+    }
     return s;
   }
 
@@ -328,7 +347,8 @@ struct Localizer::Impl {
                   " source; it cannot take a " + (kind == SourceKind::kPose ? "pose" : "twist"));
     ++src.counters.received;
     if (const auto* why = std::get_if<std::string>(&made)) return reject(id, stamp, Reason::kInvalid, *why);
-    const UpdateRecord& record = std::get<UpdateRecord>(made);
+    UpdateRecord record = std::get<UpdateRecord>(made);
+    record.biased = kind == SourceKind::kPose && !src.anchor;  // map matching; an anchor is independent of it
     if (!initialized) {
       const Duration history_span = static_cast<Duration>(config.history_steps) * history.options().step;
       if (clock_set && stamp < clock - history_span - history.options().step / 2)
@@ -416,8 +436,10 @@ struct Localizer::Impl {
     FilterState s = history.latest();
     const double dt = toSeconds(stamp - history.latestStamp());
     Matrix6d A;
+    const double vx = s.x[kVx];
     s.x = predictState(s.x, dt, A);
     s.P = propagateCovariance(A, s.P, processNoise(history.options().noise, dt));
+    if (s.bias.modelled) propagateBias(s.bias, A, vx, dt, history.options().bias_length, history.biasVariance());
     predictAux(s, history.options().aux_proc_dev, dt);
     return describe(s, stamp);
   }
@@ -429,6 +451,7 @@ struct Localizer::Impl {
     e.state = s.x;
     e.state_covariance = s.P;
     e.yaw_bias = s.x[kYawBias];
+    if (s.bias.modelled) e.map_match_bias = s.bias.b, e.map_match_bias_covariance = s.bias.P;
     const double z = s.aux[kAuxZ].initialized ? s.aux[kAuxZ].value : 0.0;
     const double roll = s.aux[kAuxRoll].initialized ? s.aux[kAuxRoll].value : 0.0;
     const double pitch = s.aux[kAuxPitch].initialized ? s.aux[kAuxPitch].value : 0.0;
@@ -495,6 +518,12 @@ void Localizer::reset() {
   d.clock = 0;
   for (Impl::Source& s : d.sources) s.gated_in_a_row = 0;
   d.integrity.restart(0, false);
+}
+
+void Localizer::setMapMatchBiasVariance(double variance) {
+  if (!(std::isfinite(variance) && variance >= 0.0 && variance <= 1e6))
+    throw Error("map-matching bias variance: must be finite and in [0, 1e6] m^2, got " + std::to_string(variance));
+  if (impl_->config.map_match_bias_sd > 0.0) impl_->history.setBiasVariance(variance);
 }
 
 const IntegrityStatus& Localizer::integrity() const { return impl_->integrity.status(); }

@@ -62,6 +62,8 @@ void updateAux(ScalarFilter& filter, double value, double variance, bool angle) 
 // at vx; yaw at wz).
 struct Model {
   Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
+  Eigen::Matrix<double, 3, 2> Hb = Eigen::Matrix<double, 3, 2>::Zero();  ///< on the map-matching bias
+  bool with_bias = false;  ///< the state models the bias: the update runs on all eight states
   Eigen::Vector3d predicted = Eigen::Vector3d::Zero();
 };
 
@@ -69,10 +71,15 @@ Model model(const FilterState& state, const UpdateRecord& record) {
   Model out;
   const double dt = record.time_offset, heading = state.x[kYaw] + state.x[kYawBias], vx = state.x[kVx];
   const double c = std::cos(heading), s = std::sin(heading);
+  out.with_bias = state.bias.modelled;
   for (int i = 0; i < record.m; ++i) {
     const int si = record.index[i];
     out.H(i, si) = 1.0;
     out.predicted[i] = state.x[si];
+    if (out.with_bias && record.biased && (si == kX || si == kY)) {
+      out.Hb(i, si) = 1.0;
+      out.predicted[i] += state.bias.b[si];
+    }
     if (dt == 0.0) continue;
     if (si == kX || si == kY) {
       const double along = si == kX ? c : s, turn = si == kX ? -s : c;
@@ -91,7 +98,11 @@ Model model(const FilterState& state, const UpdateRecord& record) {
 Innovation innovationWith(const FilterState& state, const UpdateRecord& record, const Model& mdl, double scale) {
   Innovation out;
   out.m = record.m;
-  const Eigen::Matrix<double, 3, 3> HPHt = mdl.H * state.P * mdl.H.transpose();
+  Eigen::Matrix<double, 3, 3> HPHt = mdl.H * state.P * mdl.H.transpose();
+  if (mdl.with_bias) {
+    const Eigen::Matrix<double, 3, 3> HCHb = mdl.H * state.bias.cross * mdl.Hb.transpose();
+    HPHt += HCHb + HCHb.transpose() + mdl.Hb * state.bias.P * mdl.Hb.transpose();
+  }
   for (int i = 0; i < record.m; ++i) {
     const int si = record.index[i];
     const double residual = record.value[i] - mdl.predicted[i];
@@ -99,6 +110,27 @@ Innovation innovationWith(const FilterState& state, const UpdateRecord& record, 
     for (int j = 0; j < record.m; ++j) out.S(i, j) = HPHt(i, j) + scale * record.R(i, j);
   }
   return out;
+}
+
+// The update on all eight states, the six and the bias as blocks: P H^T, the gain and the downdate
+// of each block, the same Kalman update as applyUpdate's on the six.
+bool applyWithBias(FilterState& state, const Model& mdl, const Innovation& in) {
+  MapMatchBias& bias = state.bias;
+  Eigen::Matrix<double, 8, 3> PHt;
+  PHt.topRows<6>() = state.P * mdl.H.transpose() + bias.cross * mdl.Hb.transpose();
+  PHt.bottomRows<2>() = bias.cross.transpose() * mdl.H.transpose() + bias.P * mdl.Hb.transpose();
+  Eigen::Matrix<double, 3, 8> KT = Eigen::Matrix<double, 3, 8>::Zero();
+  if (!solveSpd<8>(in.S, in.m, PHt.transpose(), KT)) return false;
+  const Eigen::Matrix<double, 8, 3> K = KT.transpose();
+  state.x += K.topRows<6>() * in.e;
+  state.x[kYaw] = wrapAngle(state.x[kYaw]);
+  bias.b += K.bottomRows<2>() * in.e;
+  state.P -= K.topRows<6>() * PHt.topRows<6>().transpose();
+  state.P = 0.5 * (state.P + state.P.transpose());
+  bias.cross -= K.topRows<6>() * PHt.bottomRows<2>().transpose();
+  bias.P -= K.bottomRows<2>() * PHt.bottomRows<2>().transpose();
+  bias.P = 0.5 * (bias.P + bias.P.transpose());
+  return true;
 }
 
 }  // namespace
@@ -122,16 +154,20 @@ bool applyUpdate(FilterState& state, const UpdateRecord& record) {
   if (record.m > 0) {
     const Model mdl = model(state, record);
     const Innovation in = innovationWith(state, record, mdl, record.scale);
-    // PHt = P H^T (rows of H beyond m are zero).
-    const Eigen::Matrix<double, 6, 3> PHt = state.P * mdl.H.transpose();
-    // K = PHt S^-1, computed as (S^-1 PHt^T)^T since S is symmetric.
-    Eigen::Matrix<double, 3, 6> KT = Eigen::Matrix<double, 3, 6>::Zero();
-    if (!solveSpd<6>(in.S, in.m, PHt.transpose(), KT)) return false;
-    const Eigen::Matrix<double, 6, 3> K = KT.transpose();
-    state.x += K * in.e;
-    state.x[kYaw] = wrapAngle(state.x[kYaw]);
-    state.P -= K * PHt.transpose();
-    state.P = 0.5 * (state.P + state.P.transpose());
+    if (mdl.with_bias) {
+      if (!applyWithBias(state, mdl, in)) return false;
+    } else {
+      // PHt = P H^T (rows of H beyond m are zero).
+      const Eigen::Matrix<double, 6, 3> PHt = state.P * mdl.H.transpose();
+      // K = PHt S^-1, computed as (S^-1 PHt^T)^T since S is symmetric.
+      Eigen::Matrix<double, 3, 6> KT = Eigen::Matrix<double, 3, 6>::Zero();
+      if (!solveSpd<6>(in.S, in.m, PHt.transpose(), KT)) return false;
+      const Eigen::Matrix<double, 6, 3> K = KT.transpose();
+      state.x += K * in.e;
+      state.x[kYaw] = wrapAngle(state.x[kYaw]);
+      state.P -= K * PHt.transpose();
+      state.P = 0.5 * (state.P + state.P.transpose());
+    }
   }
   for (int a = 0; a < 3; ++a) {
     if (record.aux_mask & (1 << a))

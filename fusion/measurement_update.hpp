@@ -21,6 +21,9 @@ struct UpdateRecord {
   /// s; the measurement was taken this long after the tick it is applied at (negative: before). The
   /// measurement model then carries the tick's state to that moment with its speed and yaw rate.
   double time_offset = 0.0;
+  /// The pose measures the position plus the map-matching bias (a source that is not an anchor), where
+  /// the state models it (FilterState::bias); otherwise ignored.
+  bool biased = false;
 };
 
 /// Innovation e = y - H x (angles wrapped) and its covariance S = H P H^T + R (R unscaled).

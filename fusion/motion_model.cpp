@@ -63,4 +63,12 @@ Matrix6d propagateCovariance(const Matrix6d& A, const Matrix6d& P, const Matrix6
   return 0.5 * (next + next.transpose());
 }
 
+void propagateBias(MapMatchBias& bias, const Matrix6d& A, double vx, double dt, double length, double variance) {
+  const double phi = std::exp(-std::abs(vx) * dt / length);
+  bias.b *= phi;
+  bias.cross = phi * (A * bias.cross);
+  bias.P = phi * phi * bias.P;
+  bias.P.diagonal().array() += (1.0 - phi * phi) * variance;
+}
+
 }  // namespace coloc::fusion

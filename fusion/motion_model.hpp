@@ -3,6 +3,7 @@
 // [x, y, yaw, yaw_bias, vx, wz]. The vehicle moves along yaw + yaw_bias; yaw is the heading the pose
 // sources measure.
 #include "coloc/core/types.hpp"
+#include "coloc/fusion/filter_state.hpp"
 
 namespace coloc::fusion {
 
@@ -30,5 +31,10 @@ Matrix6d processNoise(const ProcessNoise& noise, double dt);
 /// P' = A P A^T + Q for A of motionJacobian's form: the identity but in the rows of x, y and yaw,
 /// which is what the product visits (half the multiplications of the dense one).
 Matrix6d propagateCovariance(const Matrix6d& A, const Matrix6d& P, const Matrix6d& Q);
+
+/// The map-matching bias over one step of dt at speed vx, a random walk in distance: it fades by
+/// phi = exp(-|vx| dt / length) and its covariance goes to phi^2 P + (1 - phi^2) variance I, which
+/// stays at `variance` once there; the six states' covariance with it is carried by A and phi.
+void propagateBias(MapMatchBias& bias, const Matrix6d& A, double vx, double dt, double length, double variance);
 
 }  // namespace coloc::fusion

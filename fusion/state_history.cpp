@@ -36,8 +36,9 @@ std::optional<int> StateHistory::ticksBack(Stamp stamp) const {
 
 void StateHistory::predictInto(const FilterState& from, Slot& into, bool first_time) const {
   FilterState& prior = into.prior;
+  Matrix6d A_used;
   if (options_.relinearize || first_time) {
-    Matrix6d A;
+    Matrix6d& A = A_used;
     prior.x = predictState(from.x, dt_, A);
     prior.P = propagateCovariance(A, from.P, Q_);
     if (!options_.relinearize) {
@@ -51,6 +52,9 @@ void StateHistory::predictInto(const FilterState& from, Slot& into, bool first_t
     prior.x = into.predicted_from_linearization + into.jacobian * delta;
     prior.P = propagateCovariance(into.jacobian, from.P, Q_);
   }
+  prior.bias = from.bias;
+  if (prior.bias.modelled)
+    propagateBias(prior.bias, options_.relinearize || first_time ? A_used : into.jacobian, from.x[kVx], dt_, options_.bias_length, bias_variance_);
   prior.aux = from.aux;
   predictAux(prior, options_.aux_proc_dev, dt_);
 }

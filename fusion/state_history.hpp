@@ -26,6 +26,7 @@ struct HistoryOptions {
   ProcessNoise noise;
   std::array<double, 3> aux_proc_dev{5.0, 0.1, 0.1};  ///< z, roll, pitch random walks
   bool relinearize = true;
+  double bias_length = 10.0;            ///< m; the map-matching bias's fade (where the state models it)
 };
 
 class StateHistory {
@@ -57,6 +58,11 @@ class StateHistory {
   /// the update cannot be applied to that tick's state (innovation covariance not positive definite).
   bool addUpdate(int ticks_back, const UpdateRecord& record);
 
+  /// The map-matching bias's stationary variance from now on (the place's); the steps of the history
+  /// filtered again after a late measurement take it too, a second at most of travel.
+  void setBiasVariance(double variance) { bias_variance_ = variance; }
+  double biasVariance() const { return bias_variance_; }
+
  private:
   struct Slot {
     FilterState prior;      ///< predicted from the previous tick (the base for the oldest slot)
@@ -81,6 +87,7 @@ class StateHistory {
   int count_ = 0;
   Stamp latest_stamp_ = 0;
   int dirty_ = -1;  ///< oldest slot (ticks back) whose posterior is stale; -1 = none
+  double bias_variance_ = 0.0;
 };
 
 }  // namespace coloc::fusion

@@ -92,6 +92,18 @@ struct EkfConfig {
   /// site C (map drawn at 5 cm per axis) NDT was 10 cm across the road in a bend for 4 s and the filter
   /// said 3 cm. 0: the map is the world (Autoware's view).
   double map_error_sd = 0.0;  ///< m
+
+  // The map-matching bias (coloc's; off by default, which is Autoware's 6-state filter). NDT's error
+  // in a place is mostly the map's and the scene's, the same from one scan to the next, and a filter
+  // that takes each pose as independent either trusts it at its scan-to-scan noise and follows the
+  // bias, or at its whole error and then weighs it as independent poses, against fixes that are better.
+  // On: two more states, the bias (x, y, map frame) that every pose of a source that is not an anchor
+  // carries; a random walk in distance (Gauss-Markov: it fades to 1/e over map_match_bias_length of
+  // travel towards a stationary sd of map_match_bias_sd, or the place's from Localizer::
+  // setMapMatchBiasVariance). Anchors (roadside fixes) measure the position alone, so in coverage they
+  // tell the bias apart and NDT's poses then correct by their noise alone.
+  double map_match_bias_sd = 0.0;       ///< m; 0 = not modelled
+  double map_match_bias_length = 10.0;  ///< m
 };
 
 }  // namespace coloc::fusion

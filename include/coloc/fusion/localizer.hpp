@@ -33,6 +33,10 @@ struct Estimate {
   double yaw_bias = 0.0;
   Vector6d state = Vector6d::Zero();  ///< raw EKF state [x, y, yaw, yaw_bias, vx, wz]
   Matrix6d state_covariance = Matrix6d::Zero();
+  /// The bias NDT's poses share (EkfConfig::map_match_bias_sd; zero where not modelled): NDT's pose
+  /// minus the position, map frame, and its covariance.
+  Eigen::Vector2d map_match_bias = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d map_match_bias_covariance = Eigen::Matrix2d::Zero();
   /// Whether to believe it (see integrity.hpp); degraded or lost, pose_covariance includes the
   /// disagreement that made it so (state_covariance is the filter's own).
   LocalizationState localization = LocalizationState::kInitialising;
@@ -81,6 +85,10 @@ class Localizer {
   /// The part that doubted vouches for the position after all (a later search finds no place that
   /// matches as well): a doubt that no other disagreement has overtaken since ends.
   void confirm();
+  /// Where the map-matching bias is modelled: its spread here (m^2, per axis), which the bias fades
+  /// towards from now on (the place's, from an NDT quality map); ignored where it is not modelled.
+  /// Throws coloc::Error for a variance that is negative, NaN, infinite or above 1e6.
+  void setMapMatchBiasVariance(double variance);
 
   Verdict feedPose(SourceId source, const PoseMeasurement& measurement);
   Verdict feedPose(std::string_view source, const PoseMeasurement& measurement);
