@@ -1,5 +1,6 @@
 #include "coloc/pipeline/ndt_quality_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -25,6 +26,8 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
   map.cell_ = cell;
   map.default_variance_ = default_variance;
   std::map<std::pair<long long, long long>, std::pair<double, std::size_t>> sums;
+  double change = 0.0;
+  std::size_t changes = 0;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const NdtQualitySample& s = samples[i];
     if (!s.position.allFinite() || !s.error.allFinite() || s.position.cwiseAbs().maxCoeff() > kMaxCoordinate)
@@ -32,7 +35,13 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
     auto& sum = sums[map.indexOf(s.position)];
     sum.first += 0.5 * s.error.squaredNorm();  // x and y pooled
     ++sum.second;
+    // Two independent draws of the noise differ by twice its variance, per axis; x and y pooled.
+    if (i > 0 && (s.position - samples[i - 1].position).norm() < cell) {
+      change += 0.25 * (s.error - samples[i - 1].error).squaredNorm();
+      ++changes;
+    }
   }
+  if (changes > 0) map.noise_variance_ = std::min(change / static_cast<double>(changes), kMaxVariance);
   for (const auto& [index, sum] : sums)
     if (sum.second >= std::max<std::size_t>(min_samples, 1)) map.cells_[index] = {sum.first / static_cast<double>(sum.second), sum.second};
   return map;
@@ -51,6 +60,7 @@ std::string NdtQualityMap::toYaml() const {
       << "# Each NDT pose's x/y variance is held at least at its cell's (ndt.quality_map).\n"
       << "cell: " << cell_ << "  # m; cell [i, j] spans x in [i, i + 1) * cell, y in [j, j + 1) * cell\n"
       << "default_variance: " << default_variance_ << "  # m^2, where no cell is listed\n"
+      << "noise_variance: " << noise_variance_ << "  # m^2 per axis: NDT's scan-to-scan noise (half the mean square change between consecutive poses)\n"
       << "cells:  # [i, j, poses, variance]\n";
   if (cells_.empty()) out << "  []\n";
   for (const auto& [index, c] : cells_) out << "  - [" << index.first << ", " << index.second << ", " << c.samples << ", " << c.variance << "]\n";
@@ -61,10 +71,11 @@ NdtQualityMap NdtQualityMap::parse(const std::string& text, const std::string& s
   const YamlReader r(source);
   const YAML::Node root = r.parse(text);
   if (!root.IsMap()) r.fail(root, "(top level)", "expected a mapping with cell, default_variance and cells");
-  r.allowKeys(root, "(top level)", {"cell", "default_variance", "cells"});
+  r.allowKeys(root, "(top level)", {"cell", "default_variance", "noise_variance", "cells"});
   NdtQualityMap map;
   map.cell_ = r.inRange(r.require(root, "cell", "(top level)"), "cell", kMinCell, kMaxCell);
   map.default_variance_ = r.inRange(r.require(root, "default_variance", "(top level)"), "default_variance", 0.0, kMaxVariance);
+  if (const YAML::Node noise = root["noise_variance"]) map.noise_variance_ = r.inRange(noise, "noise_variance", 0.0, kMaxVariance);
   const YAML::Node cells = r.require(root, "cells", "(top level)");
   if (!cells.IsSequence()) r.fail(cells, "cells", "expected a list of [i, j, poses, variance]");
   const long long reach = static_cast<long long>(kMaxCoordinate / map.cell_) + 1;

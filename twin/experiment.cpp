@@ -437,6 +437,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<Eigen::Vector2d> twist_variance(config.sites.size(), Eigen::Vector2d::Zero());  // per site: vx, wz
   std::vector<std::optional<Eigen::Vector2d>> ndt_variance(config.sites.size());  // per site: x/y, yaw
   std::vector<std::string> ndt_quality(config.sites.size());  // per site: NDT's error by place (its file)
+  std::vector<double> ndt_quality_default(config.sites.size(), 0.0);  // and its mean square over the drive
 
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
   struct Recorded {
@@ -605,6 +606,11 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           if (!ndt_quality[drive.site].empty()) {
             // NDT's error on the calibration drive where the pose is the floor; the aligner's own at its default.
             job.config.ndt.quality_map = ndt_quality[drive.site];
+            if (config.map_match_bias_length > 0.0) {
+              // Its spread before the first pose is looked up: the drive's mean square.
+              job.config.fusion.map_match_bias_sd = std::sqrt(std::max(ndt_quality_default[drive.site], 1e-6));
+              job.config.fusion.map_match_bias_length = config.map_match_bias_length;
+            }
           } else {
             job.config.ndt.source.ndt.covariance_floor = cov;  // NDT's error on the calibration drive the floor
           }
@@ -812,6 +818,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
           ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();
           std::ofstream(ndt_quality[drive.site]) << quality.toYaml();
+          ndt_quality_default[drive.site] = quality.defaultVariance();
           results.ndt_quality_cells[scenario.name] = quality.cells();
         }
         continue;  // never evaluated

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <string>
 
 #include "coloc/core/error.hpp"
@@ -29,6 +30,25 @@ TEST(NdtQualityMap, EachCellHoldsTheMeanSquareOfItsPosesAndTheDefaultAnswersElse
   EXPECT_EQ(m.varianceAt({-0.1, 5.0}), 0.004) << "just outside a cell";
   EXPECT_EQ(m.varianceAt({std::nan(""), 0.0}), 0.004);
   EXPECT_EQ(NdtQualityMap().varianceAt({0.0, 0.0}), 0.0) << "an empty map floors nothing";
+}
+
+TEST(NdtQualityMap, TheScanToScanNoiseIsHalfTheMeanSquareChangeBetweenNeighboursWhateverTheBias) {
+  // 4000 poses 1 m apart: a bias of 10 cm along x that stays, and independent noise of 1 cm sd each way.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<NdtQualitySample> s;
+  for (int i = 0; i < 4000; ++i) s.push_back({{1.0 * i, 0.0}, {0.10 + noise(rng), noise(rng)}});
+  // A jump of a whole cell between two poses (the log's gap) is no neighbour, whatever their errors.
+  s.push_back({{5000.0, 0.0}, {5.0, 5.0}});
+  const NdtQualityMap m = NdtQualityMap::fromErrors(s, 10.0, 5, 0.0);
+  EXPECT_NEAR(m.noiseVariance(), 1e-4, 0.05e-4);  // 8000 differences: 1.6 % sd
+  double cells = 0.0;  // the bias in them: (bias^2 + 2 sd^2) / 2 on average
+  for (int c = 0; c < 400; ++c) cells += m.varianceAt({10.0 * c + 5.0, 0.0}) / 400.0;
+  EXPECT_NEAR(cells, (0.01 + 2e-4) / 2, 1e-4);
+  EXPECT_EQ(NdtQualityMap::parse(m.toYaml(), "q.yaml").noiseVariance(), m.noiseVariance());
+  // A file without the figure (written before it was measured) reads as not measured; a bad one is refused.
+  EXPECT_EQ(NdtQualityMap::parse("cell: 10\ndefault_variance: 0.01\ncells: []\n", "q.yaml").noiseVariance(), 0.0);
+  EXPECT_THROW(NdtQualityMap::parse("cell: 10\ndefault_variance: 0.01\nnoise_variance: -1\ncells: []\n", "q.yaml"), Error);
 }
 
 TEST(NdtQualityMap, ItsFileReadsBackToTheSameMap) {

@@ -29,8 +29,10 @@ class NdtQualityMap {
 
   /// Cells of `cell` m; a cell's variance is the mean square of its poses' x and y errors (pooled, a
   /// bias included: a map's error is NDT's error), kept where it holds at least `min_samples` poses.
-  /// `default_variance` answers elsewhere. Throws coloc::Error for a cell or default out of range or a
-  /// non-finite sample.
+  /// `default_variance` answers elsewhere. The samples in drive order also give NDT's scan-to-scan
+  /// noise: half the mean square change of the error between consecutive poses less than a cell
+  /// apart (what a bias alike from one scan to the next leaves). Throws coloc::Error for a cell or
+  /// default out of range or a non-finite sample.
   static NdtQualityMap fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples, double default_variance);
 
   /// The file `toYaml` writes; throws coloc::Error "FILE:LINE: KEY: WHY" for anything else.
@@ -40,6 +42,10 @@ class NdtQualityMap {
 
   /// The least x/y variance an NDT pose at `xy` (map frame) is worth: its cell's, else the default.
   double varianceAt(const Eigen::Vector2d& xy) const;
+
+  /// NDT's scan-to-scan noise variance per axis (0: not measured, as in files written before it was).
+  /// What an NDT pose is worth where the filter models the bias its poses share.
+  double noiseVariance() const { return noise_variance_; }
 
   double cellSize() const { return cell_; }
   double defaultVariance() const { return default_variance_; }
@@ -52,6 +58,7 @@ class NdtQualityMap {
   };
   double cell_ = 10.0;
   double default_variance_ = 0.0;
+  double noise_variance_ = 0.0;
   std::map<std::pair<long long, long long>, Cell> cells_;  ///< by (floor(x / cell), floor(y / cell))
   std::pair<long long, long long> indexOf(const Eigen::Vector2d& xy) const;
 };

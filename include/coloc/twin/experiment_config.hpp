@@ -61,6 +61,11 @@ struct ExperimentConfig {
   /// drive's one figure for the whole site, which hid NDT's good matches where the rest of the site
   /// is poor (`ndt_quality_map: by_place | site`).
   bool ndt_quality_by_place = true;
+  /// With NDT's error by place: the bias NDT's poses share as the filter's own state
+  /// (fusion.map_match_bias_sd, its spread per place from that map, each pose at NDT's scan-to-scan
+  /// noise from the same drive), fading over this much travel; 0 = not modelled, each pose floored at
+  /// its place's whole error (`map_match_bias_length`).
+  double map_match_bias_length = 0.0;
   /// Estimated by default: with the fixes carried to their tick (fusion.pose_time_alignment) the
   /// filter can trust them as much as they deserve; Table I shows the paper's figures beside it.
   RsuCovariance rsu_covariance = RsuCovariance::kEstimated;
