@@ -366,6 +366,12 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
     EXPECT_GE(e.eigenvalues().minCoeff(), 0.25 * (1.0 - 1e-9));
   }
   EXPECT_EQ(claimed, 3);
+  // With the filter's map-matching bias but no roadside fix to tell it apart, the bias is held and
+  // the poses floored at their place's whole error all the same.
+  const ReplayResult held = replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "poor.yaml") + "\nfusion:\n  map_match_bias_sd: 0.1\n");
+  EXPECT_EQ(held.pipeline_report.ndt_quality_raised, 3u);
+  for (const auto& [key, covariance] : held.claimedCovariances())
+    if (key.first == pipeline::kNdtSource) EXPECT_GE(covariance.trace(), 0.5 * (1.0 - 1e-9));
   for (const auto& [key, covariance] : plain.claimedCovariances()) {
     if (key.first != pipeline::kNdtSource) continue;
     EXPECT_LT(covariance.trace(), 0.1) << "the fit's own covariance, as before";

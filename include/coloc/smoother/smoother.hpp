@@ -48,9 +48,12 @@ struct SmootherOptions {
   /// first-order Gauss-Markov process of pose_bias_time, estimated with the states, whose size is
   /// measured where something absolute (the fixes) shows it. Without it, noise estimation takes such
   /// a source's scan-to-scan scatter for its whole error, and what it anchors (an RSU's calibration)
-  /// comes out with an uncertainty too small. Off by default: on the twin it halves the error within
-  /// RSU coverage but raises it elsewhere, as NDT's bias there is smaller than the size measured near
-  /// the RSU, which the model applies everywhere (see README).
+  /// comes out with an uncertainty too small. Beyond pose_bias_time of any pose that carries no bias
+  /// (a fix), the bias is held (it fades without new spread), as the filter holds it: there nothing
+  /// tells it apart, and the odometry's own slow errors would pass for NDT's (test
+  /// PoseBias.AwayFromTheFixes...); not while RSUs are calibrated, whose fixes carry an offset of their
+  /// own. Off by default; `coloc smooth` turns it on when calibrating or when the filter models the
+  /// bias (smoother.pose_bias: when_calibrating).
   bool pose_bias = false;
   double pose_bias_sd = 0.05;   ///< m, the start before it is measured
   double pose_bias_time = 2.0;  ///< s

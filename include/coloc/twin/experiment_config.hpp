@@ -65,7 +65,7 @@ struct ExperimentConfig {
   /// (fusion.map_match_bias_sd, its spread per place from that map, each pose at NDT's scan-to-scan
   /// noise from the same drive), fading over this much travel; 0 = not modelled, each pose floored at
   /// its place's whole error (`map_match_bias_length`).
-  double map_match_bias_length = 0.0;
+  double map_match_bias_length = 10.0;
   /// Estimated by default: with the fixes carried to their tick (fusion.pose_time_alignment) the
   /// filter can trust them as much as they deserve; Table I shows the paper's figures beside it.
   RsuCovariance rsu_covariance = RsuCovariance::kEstimated;
