@@ -313,6 +313,7 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   // measured on the drive (kBiasSource) where something absolute, the fixes, makes it visible.
   static const std::string kBiasSource = "pose bias";
   const bool bias_used = o.pose_bias && !impl_->biased.empty();  // else it stays 0, its prior's mean
+  bool bias_held = false;  // held somewhere (below): there NDT's residuals do not show its bias
   {
     const double phi = std::exp(-dt / o.pose_bias_time);
     const double inverse_sigma = 1.0 / (o.pose_bias_sd * std::sqrt(1.0 - phi * phi));
@@ -329,6 +330,7 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     // RSUs are calibrated: their fixes then carry an unknown offset of their own, and what tells it from
     // NDT's bias is the bias's wander over the whole drive (PoseBias.WithABiasedAnchor...).
     const bool hold = used && impl_->calibrated.empty();
+    bias_held = hold;
     std::vector<char> told_apart(n, hold ? 0 : 1);
     if (hold) {
       const Duration reach = fromSeconds(o.pose_bias_time);
@@ -501,7 +503,8 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
       // corridor, where the scene does not hold NDT, each pose repeats the prediction it started from,
       // agreeing with the odometry by construction. Site D's cutting: NDT measured at 0.05x its
       // covariance outvoted the RSU's fixes (6.6 cm against the filter's 1.2).
-      if (!bias_used && impl_->biased.count(source)) updated = std::max(updated, 1.0);
+      // Where the bias is held (away from the fixes) it is not modelled either.
+      if ((!bias_used || bias_held) && impl_->biased.count(source)) updated = std::max(updated, 1.0);
       double& f = factor.try_emplace(source, 1.0).first->second;
       changed = changed || std::abs(updated / f - 1.0) > 0.05;
       f = updated;

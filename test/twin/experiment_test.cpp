@@ -77,6 +77,11 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_FALSE(parseExperimentConfig("ndt_quality_map: site\n", "exp.yaml").ndt_quality_by_place);
   EXPECT_NE(errorOf("ndt_quality_map: yes\n").find("exp.yaml:1: ndt_quality_map: expected one of by_place, site"), std::string::npos)
       << errorOf("ndt_quality_map: yes\n");
+  EXPECT_DOUBLE_EQ(parseExperimentConfig("", "exp.yaml").map_match_bias_length, 10.0);
+  EXPECT_DOUBLE_EQ(parseExperimentConfig("map_match_bias_length: 0\n", "exp.yaml").map_match_bias_length, 0.0);
+  EXPECT_NE(errorOf("map_match_bias_length: -5\n").find("exp.yaml:1: map_match_bias_length: must be in [0, 10000]"), std::string::npos)
+      << errorOf("map_match_bias_length: -5\n");
+  EXPECT_NE(errorOf("map_match_bias_length: .nan\n").find("map_match_bias_length"), std::string::npos);
 }
 
 TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideIt) {
