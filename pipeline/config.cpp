@@ -389,7 +389,7 @@ const std::vector<Key>& keys() {
       {"smoother", "odometry_yaw_rate_bias_sd", "rad/s", "prior standard deviation of the odometry's yaw-rate bias around 0",
        [](const C& c) { return show(c.smoother.odometry_yaw_rate_bias_sd); },
        [](const R& r, const N& n, const S& k, C& c) { c.smoother.odometry_yaw_rate_bias_sd = r.inRange(n, k, 1e-9, 1.0); }},
-      {"smoother", "pose_bias", "", "model a slowly varying bias of map-matching poses (NDT): when_calibrating (RSUs, or the filter models it: fusion.map_match_bias_sd), always or never",
+      {"smoother", "pose_bias", "", "model a slowly varying bias of map-matching poses (NDT): when_calibrating (RSUs), always or never",
        [](const C& c) {
          using P = SmootherSection::PoseBias;
          return S(c.smoother.pose_bias == P::kAlways ? "always" : c.smoother.pose_bias == P::kNever ? "never" : "when_calibrating"); },

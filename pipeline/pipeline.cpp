@@ -476,8 +476,10 @@ struct Pipeline::Impl {
     clock_set = true;
   }
 
-  fusion::Verdict feedPose(fusion::SourceId source, const PoseMeasurement& pose) {
-    if (on_pose_input) on_pose_input(source_names[source], pose);
+  // `alone`: the pose as it is worth on its own, where the filter takes it otherwise (NDT's, beside the
+  // filter's bias state); what onPoseInput reports.
+  fusion::Verdict feedPose(fusion::SourceId source, const PoseMeasurement& pose, const PoseMeasurement* alone = nullptr) {
+    if (on_pose_input) on_pose_input(source_names[source], alone ? *alone : pose);
     const bool was_initialized = localizer.initialized();
     const fusion::Verdict v = localizer.feedPose(source, pose);
     if (!was_initialized && localizer.initialized()) emit(*localizer.estimate());
@@ -534,6 +536,10 @@ struct Pipeline::Impl {
       }
       localizer.setMapMatchBiasVariance(spread);
     }
+    // The pose on its own, for whoever takes it without the filter's bias state (the smoother, NDT's
+    // own topic, plots): at its place's whole error, which the bias's share is part of.
+    PoseMeasurement alone = pose;
+    if (place > 0.0) alone.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(pose.covariance.topLeftCorner<2, 2>(), place);
     if (floor > 0.0) {
       const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
       pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(xy, floor);
@@ -544,22 +550,23 @@ struct Pipeline::Impl {
     const double yaw = rollPitchYaw(pose.pose.orientation)[2];
     const std::optional<Eigen::Vector2d> excess = travel_check.check(pose.stamp, pose.pose.position.head<2>(), yaw);
     if (!excess) {
-      pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(pose.covariance.topLeftCorner<2, 2>(),
-                                                                         config.pipeline.travel_check_unverified_sd * config.pipeline.travel_check_unverified_sd);
+      for (PoseMeasurement* p : {&pose, &alone})
+        p->covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(p->covariance.topLeftCorner<2, 2>(),
+                                                                        config.pipeline.travel_check_unverified_sd * config.pipeline.travel_check_unverified_sd);
       ++report.ndt_travel_unverified;
     } else if (excess->squaredNorm() > 0.0) {
-      pose.covariance.topLeftCorner<2, 2>() += *excess * excess->transpose();
+      for (PoseMeasurement* p : {&pose, &alone}) p->covariance.topLeftCorner<2, 2>() += *excess * excess->transpose();
       ++report.ndt_travel_disagreements;
       report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
     }
     // Where the roadside's fixes disagree with NDT's position, its pose is worth no more than that.
     if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), yaw, place); off && off->squaredNorm() > 0.0) {
-      pose.covariance.topLeftCorner<2, 2>() += *off * off->transpose();
+      for (PoseMeasurement* p : {&pose, &alone}) p->covariance.topLeftCorner<2, 2>() += *off * off->transpose();
       ++report.ndt_fix_disagreements;
       report.ndt_fix_max_excess = std::max(report.ndt_fix_max_excess, off->norm());
     }
     const fusion::IntegrityStatus& integrity = localizer.integrity();
-    if (!feedPose(ndt_id, pose).rejected() && integrity.state != fusion::LocalizationState::kLost && !integrity.doubted) {
+    if (!feedPose(ndt_id, pose, &alone).rejected() && integrity.state != fusion::LocalizationState::kLost && !integrity.doubted) {
       speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>());
       yaw_rate_bias.addPose(outcome.pose.stamp, raw_yaw);
       mount_yaw.addPose(outcome.pose.pose.position.head<2>(), raw_yaw);

@@ -29,10 +29,7 @@ smoother::SmootherOptions smootherOptionsFor(const pipeline::Config& config, boo
   o.odometry_scale_sd = c.odometry_scale_sd;
   o.odometry_yaw_rate_bias_sd = c.odometry_yaw_rate_bias_sd;
   using PoseBias = pipeline::SmootherSection::PoseBias;
-  // As the filter: where it models NDT's bias, the smoother does too, else its poses, floored at
-  // NDT's noise alone, would hold it to NDT's bias (quick run: 0.5 -> 0.8-1.1 cm in coverage).
-  o.pose_bias = c.pose_bias == PoseBias::kAlways ||
-                (c.pose_bias == PoseBias::kWhenCalibrating && (calibrating_rsus || filter.map_match_bias_sd > 0.0));
+  o.pose_bias = c.pose_bias == PoseBias::kAlways || (c.pose_bias == PoseBias::kWhenCalibrating && calibrating_rsus);
   o.pose_bias_time = c.pose_bias_time;
   o.proc_stddev_position_c = c.proc_stddev_position_c;
   o.proc_stddev_yaw_bias_c = c.proc_stddev_yaw_bias_c;

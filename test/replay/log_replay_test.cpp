@@ -367,7 +367,8 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
   }
   EXPECT_EQ(claimed, 3);
   // With the filter's map-matching bias but no roadside fix to tell it apart, the bias is held and
-  // the poses floored at their place's whole error all the same.
+  // the filter takes the poses floored at their place's whole error all the same (raised: near a fix
+  // they would be floored at the map's noise, 0 here); reported on their own, they always are.
   const ReplayResult held = replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "poor.yaml") + "\nfusion:\n  map_match_bias_sd: 0.1\n");
   EXPECT_EQ(held.pipeline_report.ndt_quality_raised, 3u);
   for (const auto& [key, covariance] : held.claimedCovariances())

@@ -135,7 +135,9 @@ class Pipeline {
   // Outputs. Set them before the first input; they are called on the thread that drains the inbox.
   /// Every new estimate: each filter tick, and the first estimate after a pose starts the filter.
   void onEstimate(std::function<void(const fusion::Estimate&)> callback);
-  /// Every pose measurement handed to the filter (NDT results, fixes, other sources), for plots.
+  /// Every pose measurement handed to the filter (NDT results, fixes, other sources), for plots, the
+  /// smoother and NDT's own topic: each with the covariance it has on its own (where the filter models
+  /// NDT's bias, NDT's pose at its place's whole error, not the noise the filter takes it at).
   void onPoseInput(std::function<void(const std::string& source, const PoseMeasurement&)> callback);
   /// For every pose the filter took, once its smoothing is over: the filter's estimate for the pose's
   /// stamp from everything stamped up to it (the same information the source's own pose has), for

@@ -52,8 +52,9 @@ struct SmootherOptions {
   /// (a fix), the bias is held (it fades without new spread), as the filter holds it: there nothing
   /// tells it apart, and the odometry's own slow errors would pass for NDT's (test
   /// PoseBias.AwayFromTheFixes...); not while RSUs are calibrated, whose fixes carry an offset of their
-  /// own. Off by default; `coloc smooth` turns it on when calibrating or when the filter models the
-  /// bias (smoother.pose_bias: when_calibrating).
+  /// own. Off by default; `coloc smooth` turns it on when calibrating (smoother.pose_bias:
+  /// when_calibrating). Without it the smoother takes NDT's poses at their place's whole error, as the
+  /// pipeline reports them (Pipeline::onPoseInput), whether or not the filter models the bias.
   bool pose_bias = false;
   double pose_bias_sd = 0.05;   ///< m, the start before it is measured
   double pose_bias_time = 2.0;  ///< s
