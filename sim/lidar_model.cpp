@@ -325,16 +325,12 @@ void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajec
     }
   }
   world.cast(origins, directions, static_cast<float>(spec.max_range), hits);
-  if (spec.beam_divergence_vertical > 0.0) {
-    // Edges up and down are found on the centre rays' hits, before the footprint across the scan
-    // changes them.
-    thread_local std::vector<RayHit> centre;
-    centre = hits;
-    if (spec.beam_divergence > 0.0) footprintsAtEdges(spec, world, local, turns, origins, hits);
-    verticalFootprintsAtEdges(spec, world, local, turns, origins, centre, hits);
-  } else if (spec.beam_divergence > 0.0) {
-    footprintsAtEdges(spec, world, local, turns, origins, hits);
-  }
+  // Edges up and down are found on the centre rays' hits, before the footprint across the scan
+  // changes them.
+  thread_local std::vector<RayHit> centre;
+  if (spec.beam_divergence_vertical > 0.0) centre = hits;
+  if (spec.beam_divergence > 0.0) footprintsAtEdges(spec, world, local, turns, origins, hits);
+  if (spec.beam_divergence_vertical > 0.0) verticalFootprintsAtEdges(spec, world, local, turns, origins, centre, hits);
 }
 
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng) {

@@ -333,13 +333,17 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
     bias_held = hold;
     std::vector<char> told_apart(n, hold ? 0 : 1);
     if (hold) {
+      // Each fix opens its reach and closes it after; a running count over the ticks then marks every
+      // tick within one (fixes at 10 Hz overlap twenty-fold: marking each reach tick by tick repeats it).
+      std::vector<int> opened(n + 1, 0);
       const Duration reach = fromSeconds(o.pose_bias_time);
       for (const StoredPose& p : impl_->poses) {
         if (impl_->biased.count(p.source) || p.stamp + reach < first || p.stamp - reach > last) continue;
-        const std::size_t from = static_cast<std::size_t>(std::max<Duration>(0, p.stamp - reach - first) / step);
-        const std::size_t to = std::min(n - 1, static_cast<std::size_t>(std::max<Duration>(0, p.stamp + reach - first) / step));
-        for (std::size_t k = from; k <= to; ++k) told_apart[k] = 1;
+        ++opened[static_cast<std::size_t>(std::max<Duration>(0, p.stamp - reach - first) / step)];
+        --opened[std::min(n - 1, static_cast<std::size_t>(std::max<Duration>(0, p.stamp + reach - first) / step)) + 1];
       }
+      int open = 0;
+      for (std::size_t k = 0; k < n; ++k) told_apart[k] = (open += opened[k]) > 0;
     }
     for (std::size_t k = 0; k + 1 < n; ++k) {
       const bool loose = told_apart[k] || told_apart[k + 1];
