@@ -171,6 +171,8 @@ AlignedBox alignTrueSizeBox(const FittedRectangle& fit, const std::vector<Eigen:
     box.length_face_extent = next_is_length ? next.norm() : previous.norm();
     box.width_face_extent = next_is_length ? previous.norm() : next.norm();
   }
+  box.along = along;
+  box.across = across;
   box.center = a + 0.5 * length * along + 0.5 * width * across;
   const Eigen::Vector2d forward = along.dot(heading) >= 0.0 ? along : -along;
   box.yaw = std::atan2(forward.y(), forward.x());

@@ -355,6 +355,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.position = position;
   out.yaw = box.yaw;
   out.covariance = fixCovariance(box, (box.alignment_point - lidar).norm(), c.covariance);
+  out.measured_sides = measureBodySides(box, lidar, c.covariance.azimuth_step, c.body_size);
   return finish(Refusal::kNone);
 }
 

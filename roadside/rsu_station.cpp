@@ -16,6 +16,7 @@ struct RsuStation::Impl {
   int since_learned = 0;  ///< frames since the last one learned, once commissioned
   std::map<std::uint32_t, ConnectedVehicle> vehicles;
   std::map<std::uint32_t, FixConsistency> tracks;
+  std::map<std::uint32_t, BodySizeLearner> bodies;  ///< each vehicle's sides measured over its frames
   std::optional<Stamp> last_frame;
   bool levelled = false;
   std::optional<Levelling> levelling;  ///< what the road showed of the LiDAR's tilt and height
@@ -57,6 +58,7 @@ RsuStation::RsuStation(const RsuMount& mount, RsuStationConfig config) {
     throw Error("RSU station: coverage and max_cam_age must be > 0, forget_after at least max_cam_age");
   if (config.commissioning_frames < 1 || config.refresh_frames < 1 || config.learn_every < 1)
     throw Error("RSU station: commissioning_frames, refresh_frames and learn_every must be >= 1");
+  validate(config.perception.body_size);
   impl_ = std::make_unique<Impl>(mount, config);
 }
 
@@ -107,6 +109,7 @@ bool RsuStation::addVehicle(const ConnectedVehicle& v) {
   // Far older than the vehicle's last: its clock (or a replayed log's) went back; a new timeline.
   if (finite && known != d.vehicles.end() && toSeconds(known->second.stamp - v.stamp) > d.config.forget_after) {
     d.tracks.erase(known->first);
+    d.bodies.erase(known->first);
     d.vehicles.erase(known);
     known = d.vehicles.end();
   }
@@ -114,6 +117,8 @@ bool RsuStation::addVehicle(const ConnectedVehicle& v) {
     ++d.counters.cams_refused;
     return false;
   }
+  // Another size sent (a trailer hitched, another vehicle behind the id): its sides are measured afresh.
+  if (known != d.vehicles.end() && (known->second.length != v.length || known->second.width != v.width)) d.bodies.erase(v.station_id);
   d.vehicles[v.station_id] = v;
   return true;
 }
@@ -126,6 +131,7 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
   if (d.last_frame && stamp + kNanosPerSecond < *d.last_frame) {
     d.vehicles.clear();
     d.tracks.clear();
+    d.bodies.clear();
     ++d.counters.clock_resets;
   }
   d.last_frame = stamp;
@@ -144,6 +150,7 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
   for (auto it = d.vehicles.begin(); it != d.vehicles.end();) {
     if (toSeconds(stamp - it->second.stamp) > d.config.forget_after) {
       d.tracks.erase(it->first);
+      d.bodies.erase(it->first);
       it = d.vehicles.erase(it);
     } else {
       ++it;
@@ -163,7 +170,14 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
     StationOutcome o;
     o.station_id = id;
     o.distance = distance;
-    o.detection = d.perception->detect(points, stamp, centre, heading, v.length, v.width);
+    // The box's size: the CAM's, or a side its faces measured shorter over the vehicle's frames.
+    BodySizeLearner& body = d.bodies.try_emplace(id, d.config.perception.body_size).first->second;
+    const Eigen::Vector2d size = body.size(v.length, v.width);
+    o.detection = d.perception->detect(points, stamp, centre, heading, size.x(), size.y());
+    if (o.detection.found) {
+      o.detection.covariance += body.centreCovariance(v.length, v.width, o.detection.yaw);
+      body.add(o.detection.measured_sides);
+    }
     FixConsistency& track = d.tracks.try_emplace(id).first->second;
     if (!o.detection.found) {
       track.miss();

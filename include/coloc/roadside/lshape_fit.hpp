@@ -52,6 +52,8 @@ struct AlignedBox {
   /// with each face's fitted extent, m. What the fix's covariance is made of (fix_covariance.hpp).
   int length_face_points = 0, width_face_points = 0;
   double length_face_extent = 0.0, width_face_extent = 0.0;
+  /// Unit vectors from the alignment point into the box, along its length and across it.
+  Eigen::Vector2d along = Eigen::Vector2d::UnitX(), across = Eigen::Vector2d::UnitY();
 };
 
 /// Places a box of `length` x `width` on the alignment point and extends it along the rectangle's edges

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "coloc/core/time.hpp"
+#include "coloc/roadside/body_size.hpp"
 #include "coloc/roadside/fix_covariance.hpp"
 #include "coloc/roadside/lshape_fit.hpp"
 #include "coloc/roadside/road_surface.hpp"
@@ -80,6 +81,8 @@ struct RoadsidePerceptionConfig {
   bool local_road = true;
   RoadSurfaceConfig road;
   LShapeConfig lshape;
+  /// The faces' measure of the body's sides (body_size.hpp), at the covariance's azimuth step.
+  BodySizeConfig body_size;
   FixCovarianceModel covariance;
 };
 
@@ -123,6 +126,9 @@ struct VehicleDetection {
   double heading_disagreement = 0.0;  ///< rad, the fitted heading against the CAM's, modulo a half turn
   /// The fix's covariance from its fit (fix_covariance.hpp), map frame, m^2; when found.
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  /// What the fit's faces measure of the body's length and width, m (negative where they do not):
+  /// body_size.hpp; when found.
+  Eigen::Vector2d measured_sides = Eigen::Vector2d::Constant(-1.0);
   std::size_t foreground_points = 0, fit_points = 0;
   double processing_ms = 0.0;      ///< measured, the whole pipeline
 };
