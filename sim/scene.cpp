@@ -87,7 +87,7 @@ SceneObject readObject(const Reader& r, const YAML::Node& n, const std::string& 
 ErrorSources readErrors(const Reader& r, const YAML::Node& n, const ErrorSources& base = {}) {
   r.keys(n, "errors", {"preset", "survey_position_sd", "survey_yaw_sd_deg", "clock_offset_sd_ms", "clock_jitter_sd_ms", "vehicle_body",
                        "range_noise", "range_noise_per_m", "dropout", "dropout_at_max_range", "lidar_mount_yaw_deg",
-                       "map_position_sd", "map_yaw_sd_deg", "map_error_length", "cam_size_step", "beam_divergence_mrad", "beam_divergence_vertical_mrad"});
+                       "map_position_sd", "map_yaw_sd_deg", "map_error_length", "cam_size_step", "cam_length_excess", "cam_width_excess", "beam_divergence_mrad", "beam_divergence_vertical_mrad"});
   ErrorSources e = base;
   if (n["preset"]) e = r.choice(n["preset"], "errors.preset", {"real", "ideal"}) == "ideal" ? ErrorSources::ideal() : ErrorSources{};
   if (n["survey_position_sd"]) e.survey_position_sd = r.inRange(n["survey_position_sd"], "errors.survey_position_sd", 0.0, 5.0);
@@ -106,6 +106,8 @@ ErrorSources readErrors(const Reader& r, const YAML::Node& n, const ErrorSources
     if (e.map_error_length == 0.0) r.fail(n["map_error_length"], "errors.map_error_length", "must be > 0");
   }
   if (n["cam_size_step"]) e.cam_size_step = r.inRange(n["cam_size_step"], "errors.cam_size_step", 0.0, 1.0);
+  if (n["cam_length_excess"]) e.cam_length_excess = r.inRange(n["cam_length_excess"], "errors.cam_length_excess", 0.0, 1.0);
+  if (n["cam_width_excess"]) e.cam_width_excess = r.inRange(n["cam_width_excess"], "errors.cam_width_excess", 0.0, 1.0);
   if (n["beam_divergence_mrad"]) e.beam_divergence = 1e-3 * r.inRange(n["beam_divergence_mrad"], "errors.beam_divergence_mrad", 0.0, 20.0);
   if (n["beam_divergence_vertical_mrad"])
     e.beam_divergence_vertical = 1e-3 * r.inRange(n["beam_divergence_vertical_mrad"], "errors.beam_divergence_vertical_mrad", 0.0, 20.0);

@@ -502,8 +502,9 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     bag.addTopic(topic(rsu_client::kCamTopic, io::kCamType));
   }
   std::mt19937_64 cam_rng(scenario.seed + 53);  // the recorded CAMs' errors: a stream of their own
-  // The size a CAM tells the RSUs (errors.cam_size_step).
-  const auto camSize = [step = errors.cam_size_step](double size) { return io::camSizeSent(size, step); };
+  // The size a CAM tells the RSUs (errors.cam_size_step, cam_length_excess, cam_width_excess).
+  const auto camLength = [&errors](double length) { return io::camSizeSent(length + errors.cam_length_excess, errors.cam_size_step); };
+  const auto camWidth = [&errors](double width) { return io::camSizeSent(width + errors.cam_width_excess, errors.cam_size_step); };
   std::ofstream fixes_csv(out_dir + "/rsu_fixes.csv");
   fixes_csv << "stamp_s,rsu,lidar,distance_m,error_x_m,error_y_m,error_m,processing_ms,delivered\n";
   std::ofstream frames_csv(out_dir + "/rsu_frames.csv");
@@ -579,8 +580,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         c.heading = pose.z();
         c.speed = speed;
         c.yaw_rate = yaw_rate;
-        c.length = camSize(b.length);
-        c.width = camSize(b.width);
+        c.length = camLength(b.length);
+        c.width = camWidth(b.width);
         const Eigen::Vector2d centre = pose.head<2>() + Eigen::Vector2d(error(cam_rng), error(cam_rng));
         c.reference = centre + 0.5 * c.length * Eigen::Vector2d(std::cos(c.heading), std::sin(c.heading));
         bag.write(rsu_client::kCamTopic, at(t) + 1'000'000, io::encodeCam(c));
@@ -651,8 +652,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         v.centre = at_capture->head<2>() + Eigen::Vector2d(cam_error(connected_rng), cam_error(connected_rng));
         v.heading = at_capture->z();
         v.speed = other.speed;
-        v.length = camSize(other.body.length);
-        v.width = camSize(other.body.width);
+        v.length = camLength(other.body.length);
+        v.width = camWidth(other.body.width);
         r.station.addVehicle(v);
         others[v.station_id] = j;
       }
@@ -667,8 +668,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         v.heading = seen.yaw;
         v.speed = seen.speed;
         v.yaw_rate = seen.yaw_rate;
-        v.length = camSize(body.length);
-        v.width = camSize(body.width);
+        v.length = camLength(body.length);
+        v.width = camWidth(body.width);
         r.station.addVehicle(v);
       }
       const auto c_station = Clock::now();
@@ -696,7 +697,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
         ++summary.connected_fixes;
       }
       for (std::size_t v = 0; v < r.ablation.size(); ++v) {
-        const roadside::VehicleDetection dv = r.ablation[v].detect(frame, at(capture), reference, seen.yaw, camSize(body.length), camSize(body.width));
+        const roadside::VehicleDetection dv = r.ablation[v].detect(frame, at(capture), reference, seen.yaw, camLength(body.length), camWidth(body.width));
         const double e = dv.found ? (dv.position - seen.position).norm() : std::nan("");
         ablation_csv << formatSeconds(at(capture)) << "," << r.info.id << "," << r.info.lidar_model << "," << distance << ","
                      << kVariants[v].name << "," << (dv.found ? 1 : 0) << "," << e << "\n";
@@ -765,7 +766,7 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
       summary.fix_covariances[r.info.id].push_back(sent_covariance);
       // A probe whose size the operator enters: the same frame fitted with the body's own size, the
       // survey then not taking the CAM's rounding.
-      if (options.probe_size_for_commissioning && (camSize(body.length) != body.length || camSize(body.width) != body.width)) {
+      if (options.probe_size_for_commissioning && (camLength(body.length) != body.length || camWidth(body.width) != body.width)) {
         const roadside::VehicleDetection probe = r.station.perception()->detect(frame, at(capture), reference, seen.yaw, body.length, body.width);
         if (probe.found)
           summary.probe_fix_samples[r.info.id].push_back(

@@ -40,6 +40,14 @@ TEST(Scenario, ErrorsNameTheKeyAndLine) {
               "objects[0].to: must differ from `from`");
   expectError("route: {start: [0, 0], pieces: [{length: 20, curvature: 10}]}\n", "route.pieces[0].curvature: must be within +-0.25 1/m");
   expectError("objects: []\n", "needs route");
+  expectError(std::string(kRoute) + "errors: {cam_width_excess: -0.1}\n", "errors.cam_width_excess");
+}
+
+TEST(Scenario, ACamBoxLargerThanTheBodyIsReadPerSide) {
+  const Scenario s = parseScenario(std::string(kRoute) + "errors: {cam_length_excess: 0.15, cam_width_excess: 0.4}\n", "s.yaml");
+  EXPECT_DOUBLE_EQ(s.errors.cam_length_excess, 0.15);
+  EXPECT_DOUBLE_EQ(s.errors.cam_width_excess, 0.4);
+  EXPECT_DOUBLE_EQ(parseScenario(kRoute, "s.yaml").errors.cam_width_excess, 0.0) << "the body's size by default";
 }
 
 TEST(Scenario, RsusCarryTheirSurveyErrorAndClockOffsetInTheScenariosUnits) {

@@ -44,6 +44,9 @@ struct ErrorSources {
   /// in units of 0.1 m): the body then differs from the box the perception places by up to half a
   /// step (the twin's car, 4.88 x 1.84 m, is sent as 4.9 x 1.8). 0: the exact body size (the ideal twin).
   double cam_size_step = 0.1;  ///< m
+  /// What the CAM's box adds to the body before that rounding, length and width: a V2X stack that counts
+  /// the mirrors in the width or adds a margin, as a dataset's labels do. 0: the body's size.
+  double cam_length_excess = 0.0, cam_width_excess = 0.0;  ///< m
   /// Every LiDAR's horizontal beam divergence (LidarSpec::beam_divergence): returns at depth edges are
   /// mixed or bloom, as a real footprint makes them. Velodyne's manuals: 3.0 mrad horizontal, 1.5
   /// vertical. 0: each return is its centre ray's (the ideal twin).
