@@ -46,6 +46,7 @@ void validate(const BodySizeConfig& c) {
   if (!(c.corner_radius >= 0.0) || !std::isfinite(c.corner_radius)) fail("corner_radius", "finite and >= 0");
   if (!(c.quantile >= 0.0 && c.quantile <= 1.0)) fail("quantile", "in [0, 1]");
   if (!(c.tolerance >= 0.0) || !std::isfinite(c.tolerance)) fail("tolerance", "finite and >= 0");
+  if (!std::isfinite(c.frame_tolerance)) fail("frame_tolerance", "finite");
 }
 
 Eigen::Vector2d measureBodySides(const AlignedBox& box, const Eigen::Vector2d& lidar, double azimuth_step, const BodySizeConfig& c) {
@@ -80,14 +81,26 @@ Eigen::Vector2d BodySizeLearner::size(double cam_length, double cam_width) const
 namespace coloc::roadside {
 
 Eigen::Vector2d BodySizeLearner::doubt(double cam_length, double cam_width) const {
-  const Eigen::Vector2d used = size(cam_length, cam_width);
-  const bool length_learned = used.x() != cam_length, width_learned = used.y() != cam_width;
-  if (length_learned == width_learned) return Eigen::Vector2d::Constant(length_learned ? config_.tolerance : 0.0);
-  return length_learned ? Eigen::Vector2d(config_.tolerance, cam_length - used.x()) : Eigen::Vector2d(cam_width - used.y(), config_.tolerance);
+  return sizeDoubt(size(cam_length, cam_width), cam_length, cam_width, config_.tolerance);
 }
 
-Eigen::Matrix2d BodySizeLearner::centreCovariance(double cam_length, double cam_width, double yaw) const {
-  const Eigen::Vector2d half = 0.5 * doubt(cam_length, cam_width);  // half a side's error moves the centre
+Eigen::Vector2d frameBodySize(const Eigen::Vector2d& measured, double cam_length, double cam_width, const BodySizeConfig& c) {
+  constexpr double kNotWhole = 0.6;  // m short: a face not seen whole (the shortfall refusal's bound)
+  const auto side = [&](double m, double cam) {
+    const double short_by = cam - m;
+    return c.enabled && c.frame_tolerance > 0.0 && m > 0.0 && short_by > c.frame_tolerance && short_by <= kNotWhole ? m : cam;
+  };
+  return {side(measured.x(), cam_length), side(measured.y(), cam_width)};
+}
+
+Eigen::Vector2d sizeDoubt(const Eigen::Vector2d& used, double cam_length, double cam_width, double tolerance) {
+  const bool length_measured = used.x() != cam_length, width_measured = used.y() != cam_width;
+  if (length_measured == width_measured) return Eigen::Vector2d::Constant(length_measured ? tolerance : 0.0);
+  return length_measured ? Eigen::Vector2d(tolerance, cam_length - used.x()) : Eigen::Vector2d(cam_width - used.y(), tolerance);
+}
+
+Eigen::Matrix2d sizeCovariance(const Eigen::Vector2d& doubt, double yaw) {
+  const Eigen::Vector2d half = 0.5 * doubt;  // half a side's error moves the centre
   const Eigen::Vector2d along(std::cos(yaw), std::sin(yaw)), across(-along.y(), along.x());
   return half.x() * half.x() * along * along.transpose() + half.y() * half.y() * across * across.transpose();
 }

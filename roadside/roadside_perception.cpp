@@ -347,6 +347,11 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     if (off > c.max_heading_disagreement) return finish(Refusal::kHeadingDisagrees);
   }
   if (c.attribute && static_cast<int>(xy.size()) < c.min_fit_points) return finish(Refusal::kTooFewPoints);
+  // What the faces measure of the body; a side this frame finds far shorter than the CAM's (a label's
+  // or a CAM's box larger than the body: body_size.hpp) places the box instead.
+  const Eigen::Vector2d measured = measureBodySides(box, lidar, c.covariance.azimuth_step, c.body_size);
+  const Eigen::Vector2d size = frameBodySize(measured, length, width, c.body_size);
+  if (size != Eigen::Vector2d(length, width)) box.center = box.alignment_point + 0.5 * size.x() * box.along + 0.5 * size.y() * box.across;
   const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
   if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);
   out.found = true;
@@ -355,7 +360,8 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.position = position;
   out.yaw = box.yaw;
   out.covariance = fixCovariance(box, (box.alignment_point - lidar).norm(), c.covariance);
-  out.measured_sides = measureBodySides(box, lidar, c.covariance.azimuth_step, c.body_size);
+  if (size != Eigen::Vector2d(length, width)) out.covariance += sizeCovariance(sizeDoubt(size, length, width, c.body_size.tolerance), box.yaw);
+  out.measured_sides = measured;
   return finish(Refusal::kNone);
 }
 

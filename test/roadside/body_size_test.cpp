@@ -56,7 +56,7 @@ TEST(BodySize, ASideMeasuredShorterThanTheCamsOverFiveFramesIsUsedAndTheOtherSid
   EXPECT_NEAR(learner.doubt(5.0, 2.2).x(), 0.34, 1e-12);
   EXPECT_NEAR(learner.doubt(5.0, 2.2).y(), 0.1, 1e-12);
   // Along the heading (here the y axis) half the length's doubt; across it half the width's.
-  const Eigen::Matrix2d c = learner.centreCovariance(5.0, 2.2, 0.5 * M_PI);
+  const Eigen::Matrix2d c = sizeCovariance(learner.doubt(5.0, 2.2), 0.5 * M_PI);
   EXPECT_NEAR(c(1, 1), 0.17 * 0.17, 1e-12);
   EXPECT_NEAR(c(0, 0), 0.05 * 0.05, 1e-12);
   EXPECT_NEAR(c(0, 1), 0.0, 1e-12);
@@ -72,6 +72,18 @@ TEST(BodySize, MeasuresWithinTheCamsRoundingOrLongerKeepTheCamsSize) {
   for (int i = 0; i < 5; ++i) skipped.add({std::nan(""), -1.0});
   skipped.add({std::numeric_limits<double>::infinity(), 0.0});
   EXPECT_EQ(skipped.size(5.0, 2.2), Eigen::Vector2d(5.0, 2.2));
+}
+
+TEST(BodySize, OneFramesMeasureIsUsedOnlyWhenAskedAndFarShorterThanTheCamsButNotSoShortItIsPartial) {
+  EXPECT_EQ(frameBodySize({-1.0, 1.85}, 5.0, 2.2), Eigen::Vector2d(5.0, 2.2)) << "off by default";
+  BodySizeConfig c;
+  c.frame_tolerance = 0.25;
+  EXPECT_EQ(frameBodySize({-1.0, 1.85}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 1.85));
+  EXPECT_EQ(frameBodySize({4.80, 2.0}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 2.2)) << "within the frame's tolerance";
+  EXPECT_EQ(frameBodySize({-1.0, 1.5}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 2.2)) << "0.7 m short: a face not seen whole";
+  // The width measured: the length kept is doubted by the width's excess.
+  EXPECT_TRUE(sizeDoubt({5.0, 1.85}, 5.0, 2.2, 0.1).isApprox(Eigen::Vector2d(0.35, 0.1)));
+  EXPECT_EQ(sizeDoubt({5.0, 2.2}, 5.0, 2.2, 0.1), Eigen::Vector2d::Zero());
 }
 
 TEST(BodySize, OnlyTheLatestMeasuresCount) {
