@@ -47,6 +47,7 @@ void validate(const BodySizeConfig& c) {
   if (!(c.quantile >= 0.0 && c.quantile <= 1.0)) fail("quantile", "in [0, 1]");
   if (!(c.tolerance >= 0.0) || !std::isfinite(c.tolerance)) fail("tolerance", "finite and >= 0");
   if (!std::isfinite(c.frame_tolerance)) fail("frame_tolerance", "finite");
+  if (!std::isfinite(c.doubt_tolerance)) fail("doubt_tolerance", "finite");
 }
 
 Eigen::Vector2d measureBodySides(const AlignedBox& box, const Eigen::Vector2d& lidar, double azimuth_step, const BodySizeConfig& c) {
@@ -97,6 +98,18 @@ Eigen::Vector2d sizeDoubt(const Eigen::Vector2d& used, double cam_length, double
   const bool length_measured = used.x() != cam_length, width_measured = used.y() != cam_width;
   if (length_measured == width_measured) return Eigen::Vector2d::Constant(length_measured ? tolerance : 0.0);
   return length_measured ? Eigen::Vector2d(tolerance, cam_length - used.x()) : Eigen::Vector2d(cam_width - used.y(), tolerance);
+}
+
+Eigen::Vector2d frameDoubt(const Eigen::Vector2d& measured, const Eigen::Vector2d& used, double cam_length, double cam_width,
+                           const BodySizeConfig& c) {
+  constexpr double kNotWhole = 0.6;  // m short: a face not seen whole
+  if (!c.enabled || !(c.doubt_tolerance > 0.0)) return Eigen::Vector2d::Zero();
+  const auto excess = [&](double m, double u, double cam) {
+    const double short_by = cam - m;
+    return u == cam && m > 0.0 && short_by > c.doubt_tolerance && short_by <= kNotWhole ? short_by : 0.0;
+  };
+  const double doubt = std::max(excess(measured.x(), used.x(), cam_length), excess(measured.y(), used.y(), cam_width));
+  return Eigen::Vector2d::Constant(doubt);
 }
 
 Eigen::Matrix2d sizeCovariance(const Eigen::Vector2d& doubt, double yaw) {

@@ -361,6 +361,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.yaw = box.yaw;
   out.covariance = fixCovariance(box, (box.alignment_point - lidar).norm(), c.covariance);
   if (size != Eigen::Vector2d(length, width)) out.covariance += sizeCovariance(sizeDoubt(size, length, width, c.body_size.tolerance), box.yaw);
+  out.covariance += sizeCovariance(frameDoubt(measured, size, length, width, c.body_size), box.yaw);
   out.measured_sides = measured;
   return finish(Refusal::kNone);
 }

@@ -86,6 +86,16 @@ TEST(BodySize, OneFramesMeasureIsUsedOnlyWhenAskedAndFarShorterThanTheCamsButNot
   EXPECT_EQ(sizeDoubt({5.0, 2.2}, 5.0, 2.2, 0.1), Eigen::Vector2d::Zero());
 }
 
+TEST(BodySize, OneFrameFindingTheCamFarTooLargeDoubtsBothSidesUntilTheSideIsPlacedWithAMeasure) {
+  // The width measured 0.36 m short of the CAM's and placed with the CAM's: both sides doubted by it.
+  EXPECT_TRUE(frameDoubt({-1.0, 1.84}, {5.0, 2.2}, 5.0, 2.2).isApprox(Eigen::Vector2d(0.36, 0.36)));
+  // Within the doubt's tolerance (a 1.84 m body sent as 1.8, its front measured short), or placed with
+  // the station's measure already, or not seen whole: none.
+  EXPECT_EQ(frameDoubt({-1.0, 1.62}, {4.9, 1.8}, 4.9, 1.8), Eigen::Vector2d::Zero());
+  EXPECT_EQ(frameDoubt({-1.0, 1.84}, {5.0, 1.86}, 5.0, 2.2), Eigen::Vector2d::Zero());
+  EXPECT_EQ(frameDoubt({-1.0, 1.5}, {5.0, 2.2}, 5.0, 2.2), Eigen::Vector2d::Zero());
+}
+
 TEST(BodySize, OnlyTheLatestMeasuresCount) {
   BodySizeConfig config;
   config.max_measures = 3;
@@ -118,6 +128,9 @@ TEST(BodySize, AConfigurationOutOfRangeIsRefusedNamingTheKey) {
   c = {};
   c.tolerance = -0.1;
   refused(c, "tolerance");
+  c = {};
+  c.doubt_tolerance = std::numeric_limits<double>::infinity();
+  refused(c, "doubt_tolerance");
   c = {};
   c.max_incidence = M_PI;
   refused(c, "max_incidence");

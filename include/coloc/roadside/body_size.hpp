@@ -43,11 +43,15 @@ struct BodySizeConfig {
   /// the rounded 4.9 x 1.8 m CAM's car 0.25 m short in 3-7 frames a drive, and those fixes went from 5-18
   /// cm to 16-35 cm.
   double frame_tolerance = 0.0;
+  /// m: one frame's measure shorter than the CAM's side by more than this, where the side is not placed
+  /// with it, makes that frame's fix doubt both sides by as much (sizeDoubt): the covariance says what
+  /// the frame shows, the position waits for the station's measures. <= 0: off.
+  double doubt_tolerance = 0.25;
 };
 
 /// Throws coloc::Error naming the first key out of range (min_points, min_measures >= 1, max_measures at
 /// least min_measures; max_incidence and arc_grazing in (0, 90) deg; quantile in [0, 1]; tolerance,
-/// frame_tolerance and corner_radius finite, the first and last >= 0).
+/// frame_tolerance, doubt_tolerance and corner_radius finite, the first and last >= 0).
 void validate(const BodySizeConfig& config);
 
 /// What the faces at a box's seen corner measure of the body's length and width (m; negative where a
@@ -63,6 +67,12 @@ Eigen::Vector2d frameBodySize(const Eigen::Vector2d& measured, double cam_length
 /// measured instead of the CAM's, the tolerance; a CAM's side kept while the other was found too large,
 /// as much as that one was (a CAM that overstates one side may overstate the other); else 0.
 Eigen::Vector2d sizeDoubt(const Eigen::Vector2d& used, double cam_length, double cam_width, double tolerance);
+
+/// The doubt one frame's `measured` sides cast on the box placed with `used` (the CAM's, or the
+/// station's or the frame's measure): for a side placed with the CAM's yet measured shorter by more
+/// than doubt_tolerance (and by no more than 0.6 m), that shortfall on both sides; else 0.
+Eigen::Vector2d frameDoubt(const Eigen::Vector2d& measured, const Eigen::Vector2d& used, double cam_length, double cam_width,
+                           const BodySizeConfig& config = {});
 
 /// What a doubt on the sides (sizeDoubt) adds to the covariance of the box's centre at heading `yaw`: half
 /// of each side's, along it, m^2.
