@@ -10,6 +10,8 @@ namespace coloc::roadside {
 
 namespace {
 
+constexpr double kNotWhole = 0.6;  // m: a face shorter than its side by more is not seen whole (the shortfall refusal's bound)
+
 // The face from `corner` along `direction` over `extent`, with `points` returns: its side, or -1.
 double measureSide(const Eigen::Vector2d& corner, const Eigen::Vector2d& direction, double extent, int points, const Eigen::Vector2d& lidar,
                    double azimuth_step, const BodySizeConfig& c) {
@@ -77,16 +79,11 @@ Eigen::Vector2d BodySizeLearner::size(double cam_length, double cam_width) const
   return {side(length_, cam_length), side(width_, cam_width)};
 }
 
-}  // namespace coloc::roadside
-
-namespace coloc::roadside {
-
 Eigen::Vector2d BodySizeLearner::doubt(double cam_length, double cam_width) const {
   return sizeDoubt(size(cam_length, cam_width), cam_length, cam_width, config_.tolerance);
 }
 
 Eigen::Vector2d frameBodySize(const Eigen::Vector2d& measured, double cam_length, double cam_width, const BodySizeConfig& c) {
-  constexpr double kNotWhole = 0.6;  // m short: a face not seen whole (the shortfall refusal's bound)
   const auto side = [&](double m, double cam) {
     const double short_by = cam - m;
     return c.enabled && c.frame_tolerance > 0.0 && m > 0.0 && short_by > c.frame_tolerance && short_by <= kNotWhole ? m : cam;
@@ -102,7 +99,6 @@ Eigen::Vector2d sizeDoubt(const Eigen::Vector2d& used, double cam_length, double
 
 Eigen::Vector2d frameDoubt(const Eigen::Vector2d& measured, const Eigen::Vector2d& used, double cam_length, double cam_width,
                            const BodySizeConfig& c) {
-  constexpr double kNotWhole = 0.6;  // m short: a face not seen whole
   if (!c.enabled || !(c.doubt_tolerance > 0.0)) return Eigen::Vector2d::Zero();
   const auto excess = [&](double m, double u, double cam) {
     const double short_by = cam - m;
