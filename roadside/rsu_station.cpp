@@ -175,7 +175,10 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
     const Eigen::Vector2d size = body.size(v.length, v.width);
     o.detection = d.perception->detect(points, stamp, centre, heading, size.x(), size.y());
     if (o.detection.found) {
-      if (size != Eigen::Vector2d(v.length, v.width)) o.detection.covariance += sizeCovariance(body.doubt(v.length, v.width), o.detection.yaw);
+      if (size != Eigen::Vector2d(v.length, v.width)) {
+        o.detection.covariance += sizeCovariance(body.doubt(v.length, v.width), o.detection.yaw);
+        ++d.counters.fixes_with_measured_size;
+      }
       body.add(o.detection.measured_sides);
     }
     FixConsistency& track = d.tracks.try_emplace(id).first->second;

@@ -97,6 +97,9 @@ void printCounters(const roadside::RsuStation& station) {
   if (const auto l = station.levelling())
     std::printf("  levelled from the road: roll %.2f deg, pitch %.2f deg, %.2f m above it (the registry's tilt replaced)\n", l->roll * 180.0 / M_PI,
                 l->pitch * 180.0 / M_PI, l->height);
+  if (c.fixes_with_measured_size)
+    std::printf("  %llu fixes placed with a side the vehicle's frames measured shorter than its CAM said (a CAM box larger than the body)\n",
+                (unsigned long long)c.fixes_with_measured_size);
   if (c.clock_resets) std::printf("  the frames' clock went back %llu times: CAMs and tracks started afresh each time\n", (unsigned long long)c.clock_resets);
   if (const auto plane = station.roadPlane()) {
     const roadside::Levelling l = roadside::levellingOf(*plane);

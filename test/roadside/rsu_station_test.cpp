@@ -270,39 +270,57 @@ TEST_F(Station, CommissionedFromASurveyedEmptyFrameItFixesFromTheFirstFrames) {
 // body's centre. The station measures the width from the frames that see the car's front and places the
 // box with it from then on; the same car, its CAM sent again with another size, is measured afresh.
 TEST_F(Station, AVehicleWhoseCamOverstatesItsWidthIsPlacedWithTheWidthItsFramesMeasure) {
-  const auto pass = [&](bool measure, std::vector<double>* across_errors, int* measured_from) {
+  struct Pass {
+    std::vector<double> across;  ///< each fix's distance across the lane from the body's centre, m
+    int measured_from = -1;      ///< the first frame placed within 8 cm across
+    std::uint64_t counted = 0;   ///< fixes the station counts as placed with a measured side
+    double after_new_size = -1;  ///< across, the first fix after the CAM sent another size
+  };
+  const auto pass = [&](bool measure) {
     RsuStationConfig config;
     config.perception.body_size.enabled = measure;
     config.commissioning_frames = 20;
     RsuStation station(mount_, config);
     commissionOnAnEmptyStreet(station, 20);
     const Car car{-62, 8, 0, 0};  // seen from 62 to 19 m, nearer under the pole's lowest beam
-    for (int k = 0; k < 60; ++k) {
+    Pass out;
+    for (int k = 0; k < 56; ++k) {
       const double t = 0.1 * k;
       place({car, {-90, 0, 30, 0}, {-100, 0, 30, 0}}, t);
       ConnectedVehicle v = cam(1001, car, t - 0.05, 10.0);
-      v.width = std::round((car_.width + 0.4) * 10.0) / 10.0;
+      v.width = std::round((car_.width + (k < 50 ? 0.4 : 0.5)) * 10.0) / 10.0;  // from frame 50 another size
       v.length = std::round((car_.length + 0.1) * 10.0) / 10.0;
       station.addVehicle(v);
       for (const StationOutcome& o : station.frame(frame(), fromSeconds(10.0 + t))) {
-        if (o.detection.found) {
-          across_errors->push_back(std::abs(o.detection.position.y() - car.y));
-          if (*measured_from < 0 && across_errors->back() < 0.08) *measured_from = k;
-        }}
+        if (!o.detection.found) continue;
+        const double across = std::abs(o.detection.position.y() - car.y);
+        if (k >= 50) {
+          if (out.after_new_size < 0.0) out.after_new_size = across;
+          continue;
+        }
+        out.across.push_back(across);
+        if (out.measured_from < 0 && across < 0.08) out.measured_from = k;
+      }
     }
+    out.counted = station.counters().fixes_with_measured_size;
+    return out;
   };
-  std::vector<double> cam_size, measured;
-  int unused = -1, measured_from = -1;
-  pass(false, &cam_size, &unused);
-  pass(true, &measured, &measured_from);
-  ASSERT_GE(cam_size.size(), 20u);
-  ASSERT_GE(measured.size(), 20u);
-  std::sort(cam_size.begin(), cam_size.end());
-  std::sort(measured.begin(), measured.end());
-  std::printf("across the lane, median: the CAM's width %.3f m (%zu fixes), measured %.3f m (%zu fixes, from frame %d)\n", cam_size[cam_size.size() / 2],
-              cam_size.size(), measured[measured.size() / 2], measured.size(), measured_from);
-  EXPECT_GT(cam_size[cam_size.size() / 2], 0.12) << "the CAM's 0.36 m excess shows across the lane";
-  EXPECT_LT(measured[measured.size() / 2], 0.06);
+  Pass cam_size = pass(false), measured = pass(true);
+  ASSERT_GE(cam_size.across.size(), 20u);
+  ASSERT_GE(measured.across.size(), 20u);
+  std::sort(cam_size.across.begin(), cam_size.across.end());
+  std::sort(measured.across.begin(), measured.across.end());
+  std::printf("across the lane, median: the CAM's width %.3f m (%zu fixes), measured %.3f m (%zu fixes, from frame %d, %llu counted); "
+              "the first fix after another size %.3f m\n",
+              cam_size.across[cam_size.across.size() / 2], cam_size.across.size(), measured.across[measured.across.size() / 2],
+              measured.across.size(), measured.measured_from, (unsigned long long)measured.counted, measured.after_new_size);
+  EXPECT_GT(cam_size.across[cam_size.across.size() / 2], 0.12) << "the CAM's 0.36 m excess shows across the lane";
+  EXPECT_LT(measured.across[measured.across.size() / 2], 0.06);
+  EXPECT_EQ(cam_size.counted, 0u);
+  EXPECT_GE(measured.counted, measured.across.size() / 2) << "the fixes placed with the width measured are counted";
+  // Another size in the CAM: the sides are measured afresh, the first fix placed with the new CAM's.
+  ASSERT_GE(measured.after_new_size, 0.0) << "no fix after the CAM's new size";
+  EXPECT_GT(measured.after_new_size, 0.15);
 }
 
 TEST_F(Station, AConfigurationOutOfRangeIsRefusedNamingTheKeys) {

@@ -59,6 +59,9 @@ struct StationCounters {
   std::uint64_t frames = 0, commissioning_frames = 0, cams = 0, cams_refused = 0, fixes = 0;
   std::array<std::uint64_t, kRefusalCount> refused{};  ///< per Refusal
   std::uint64_t background_rebuilds = 0;
+  /// Fixes whose box was placed with a side the vehicle's frames measured shorter than its CAM's
+  /// (a CAM box larger than the body: body_size.hpp).
+  std::uint64_t fixes_with_measured_size = 0;
   std::uint64_t clock_resets = 0;  ///< frames stamped more than 1 s before the last: CAMs and tracks forgotten
 };
 
