@@ -174,19 +174,19 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
     BodySizeLearner& body = d.bodies.try_emplace(id, d.config.perception.body_size).first->second;
     const Eigen::Vector2d size = body.size(v.length, v.width);
     o.detection = d.perception->detect(points, stamp, centre, heading, size.x(), size.y());
-    if (o.detection.found) {
-      if (size != Eigen::Vector2d(v.length, v.width)) {
-        o.detection.covariance += sizeCovariance(body.doubt(v.length, v.width), o.detection.yaw);
-        ++d.counters.fixes_with_measured_size;
-      }
-      body.add(o.detection.measured_sides);
-    }
+    const bool measured_size = size != Eigen::Vector2d(v.length, v.width);
+    if (o.detection.found && measured_size) o.detection.covariance += sizeCovariance(body.doubt(v.length, v.width), o.detection.yaw);
     FixConsistency& track = d.tracks.try_emplace(id).first->second;
     if (!o.detection.found) {
       track.miss();
     } else if (!track.agrees(stamp, o.detection.position, v.speed * Eigen::Vector2d(std::cos(heading), std::sin(heading)))) {
       o.detection.found = false;
       o.detection.refusal = Refusal::kInconsistent;
+    }
+    // Measures from the fixes sent only: a fit the track refused may be another object's.
+    if (o.detection.found) {
+      body.add(o.detection.measured_sides);
+      if (measured_size) ++d.counters.fixes_with_measured_size;
     }
     if (o.detection.found) ++d.counters.fixes;
     else ++d.counters.refused[static_cast<std::size_t>(o.detection.refusal)];
