@@ -10,8 +10,6 @@ namespace coloc::roadside {
 
 namespace {
 
-constexpr double kNotWhole = 0.6;  // m: a face shorter than its side by more is not seen whole (the shortfall refusal's bound)
-
 // The face from `corner` along `direction` over `extent`, with `points` returns: its side, or -1.
 double measureSide(const Eigen::Vector2d& corner, const Eigen::Vector2d& direction, double extent, int points, const Eigen::Vector2d& lidar,
                    double azimuth_step, const BodySizeConfig& c) {
@@ -50,6 +48,7 @@ void validate(const BodySizeConfig& c) {
   if (!(c.tolerance >= 0.0) || !std::isfinite(c.tolerance)) fail("tolerance", "finite and >= 0");
   if (!std::isfinite(c.frame_tolerance)) fail("frame_tolerance", "finite");
   if (!std::isfinite(c.doubt_tolerance)) fail("doubt_tolerance", "finite");
+  if (!(c.max_shortfall > 0.0) || !std::isfinite(c.max_shortfall)) fail("max_shortfall", "finite and > 0");
 }
 
 Eigen::Vector2d measureBodySides(const AlignedBox& box, const Eigen::Vector2d& lidar, double azimuth_step, const BodySizeConfig& c) {
@@ -86,7 +85,7 @@ Eigen::Vector2d BodySizeLearner::doubt(double cam_length, double cam_width) cons
 Eigen::Vector2d frameBodySize(const Eigen::Vector2d& measured, double cam_length, double cam_width, const BodySizeConfig& c) {
   const auto side = [&](double m, double cam) {
     const double short_by = cam - m;
-    return c.enabled && c.frame_tolerance > 0.0 && m > 0.0 && short_by > c.frame_tolerance && short_by <= kNotWhole ? m : cam;
+    return c.enabled && c.frame_tolerance > 0.0 && m > 0.0 && short_by > c.frame_tolerance && short_by <= c.max_shortfall ? m : cam;
   };
   return {side(measured.x(), cam_length), side(measured.y(), cam_width)};
 }
@@ -102,7 +101,7 @@ Eigen::Vector2d frameDoubt(const Eigen::Vector2d& measured, const Eigen::Vector2
   if (!c.enabled || !(c.doubt_tolerance > 0.0)) return Eigen::Vector2d::Zero();
   const auto excess = [&](double m, double u, double cam) {
     const double short_by = cam - m;
-    return u == cam && m > 0.0 && short_by > c.doubt_tolerance && short_by <= kNotWhole ? short_by : 0.0;
+    return u == cam && m > 0.0 && short_by > c.doubt_tolerance && short_by <= c.max_shortfall ? short_by : 0.0;
   };
   const double doubt = std::max(excess(measured.x(), used.x(), cam_length), excess(measured.y(), used.y(), cam_width));
   return Eigen::Vector2d::Constant(doubt);

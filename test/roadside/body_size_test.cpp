@@ -132,6 +132,9 @@ TEST(BodySize, AConfigurationOutOfRangeIsRefusedNamingTheKey) {
   c.doubt_tolerance = std::numeric_limits<double>::infinity();
   refused(c, "doubt_tolerance");
   c = {};
+  c.max_shortfall = 0.0;
+  refused(c, "max_shortfall");
+  c = {};
   c.max_incidence = M_PI;
   refused(c, "max_incidence");
 }

@@ -35,6 +35,10 @@ struct BodySizeConfig {
   int max_measures = 50;                       ///< the latest kept per side
   double quantile = 0.9;                       ///< of the measures: the frames that saw the end
   double tolerance = 0.1;                      ///< m: the CAM rounding up by half its 0.1 m step, the face's end short by as much
+  /// m: one frame's measure shorter than the CAM's side by more is a face not seen whole (its far end
+  /// hidden or lost), neither used nor doubting: the perception's bound on a face seen alone
+  /// (RoadsidePerceptionConfig::max_width_face_shortfall).
+  double max_shortfall = 0.6;
   /// m: one frame's measure shorter than the CAM's side by more than this is that frame's side (for a
   /// caller of the perception frame by frame, without a station). <= 0: off, the default: one frame is
   /// not enough. From a pole (test HighMount.*, OS1-64 at 2-8 m) a 1.84 m front sent as 1.8 m measured
@@ -51,7 +55,7 @@ struct BodySizeConfig {
 
 /// Throws coloc::Error naming the first key out of range (min_points, min_measures >= 1, max_measures at
 /// least min_measures; max_incidence and arc_grazing in (0, 90) deg; quantile in [0, 1]; tolerance,
-/// frame_tolerance, doubt_tolerance and corner_radius finite, the first and last >= 0).
+/// frame_tolerance, doubt_tolerance and corner_radius finite, the first and last >= 0; max_shortfall > 0).
 void validate(const BodySizeConfig& config);
 
 /// What the faces at a box's seen corner measure of the body's length and width (m; negative where a
@@ -60,7 +64,7 @@ void validate(const BodySizeConfig& config);
 Eigen::Vector2d measureBodySides(const AlignedBox& box, const Eigen::Vector2d& lidar, double azimuth_step, const BodySizeConfig& config = {});
 
 /// One frame's size to place the box with: the CAM's, or a side `measured` shorter than it by more
-/// than frame_tolerance (and by no more than 0.6 m: a face that short is not seen whole).
+/// than frame_tolerance (and by no more than max_shortfall: a face that short is not seen whole).
 Eigen::Vector2d frameBodySize(const Eigen::Vector2d& measured, double cam_length, double cam_width, const BodySizeConfig& config = {});
 
 /// The sd of each side of `used` beyond what the fix's covariance counts (the CAM's rounding), m: a side
@@ -70,7 +74,7 @@ Eigen::Vector2d sizeDoubt(const Eigen::Vector2d& used, double cam_length, double
 
 /// The doubt one frame's `measured` sides cast on the box placed with `used` (the CAM's, or the
 /// station's or the frame's measure): for a side placed with the CAM's yet measured shorter by more
-/// than doubt_tolerance (and by no more than 0.6 m), that shortfall on both sides; else 0.
+/// than doubt_tolerance (and by no more than max_shortfall), that shortfall on both sides; else 0.
 Eigen::Vector2d frameDoubt(const Eigen::Vector2d& measured, const Eigen::Vector2d& used, double cam_length, double cam_width,
                            const BodySizeConfig& config = {});
 
