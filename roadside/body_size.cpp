@@ -49,6 +49,8 @@ void validate(const BodySizeConfig& c) {
   if (!std::isfinite(c.frame_tolerance)) fail("frame_tolerance", "finite");
   if (!std::isfinite(c.doubt_tolerance)) fail("doubt_tolerance", "finite");
   if (!(c.max_shortfall > 0.0) || !std::isfinite(c.max_shortfall)) fail("max_shortfall", "finite and > 0");
+  if (!(c.min_seen_height >= 0.0) || !std::isfinite(c.min_seen_height)) fail("min_seen_height", "finite and >= 0");
+  if (!(c.end_clearance >= 0.0) || !std::isfinite(c.end_clearance)) fail("end_clearance", "finite and >= 0");
 }
 
 Eigen::Vector2d measureBodySides(const AlignedBox& box, const Eigen::Vector2d& lidar, double azimuth_step, const BodySizeConfig& c) {

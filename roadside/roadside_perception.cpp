@@ -139,6 +139,36 @@ AlignedBox fitBody(const std::vector<std::size_t>& points, const std::vector<Eig
   return alignTrueSizeBox(rectangle, xy, lidar, length, width, heading_prior);
 }
 
+// Whether a face's far end, `end`, is seen as its end (BodySizeConfig::end_clearance): the LiDAR's
+// next columns beyond it, away from `corner`, at elevations lo..hi (rad, those the body was seen at),
+// return from farther than the end by `clearance`, and none from nearer. `rotation` turns a frame's
+// point into the map's axes; `lidar` is the LiDAR in the map.
+bool endSeen(const std::vector<Eigen::Vector3f>& frame, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& lidar, const Eigen::Vector2d& corner,
+             const Eigen::Vector2d& end, double lo, double hi, double azimuth_step, double clearance) {
+  const Eigen::Vector2d e = end - lidar.head<2>(), k = corner - lidar.head<2>();
+  const double end_range = e.norm();
+  if (!(end_range > 1e-6) || !(azimuth_step > 0.0)) return false;
+  const Eigen::Vector2d u = e / end_range;
+  // Beyond is the side of the end away from the corner.
+  const double away = u.x() * k.y() - u.y() * k.x() > 0.0 ? -1.0 : 1.0;
+  const double first = 0.5 * azimuth_step, last = 2.5 * azimuth_step, tan_last = std::tan(last);
+  bool beyond = false;
+  for (const Eigen::Vector3f& p : frame) {
+    if (!p.allFinite()) continue;
+    const Eigen::Vector3d q = rotation * p.cast<double>() + lidar;
+    const Eigen::Vector2d d = q.head<2>() - lidar.head<2>();
+    const double along = d.dot(u), side = away * (u.x() * d.y() - u.y() * d.x());
+    if (!(along > 0.0) || !(side > 0.0) || side > along * tan_last) continue;  // outside the columns, cheaply
+    const double angle = std::atan2(side, along);
+    if (angle <= first || angle > last) continue;
+    const double range = d.norm(), elevation = std::atan2(q.z() - lidar.z(), range);
+    if (elevation < lo || elevation > hi) continue;
+    if (range < end_range + clearance) return false;
+    beyond = true;
+  }
+  return beyond;
+}
+
 }  // namespace
 
 VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& frame, Stamp stamp, const Eigen::Vector2d& reference,
@@ -350,7 +380,29 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // What the faces measure of the body; a side this frame finds far shorter than the CAM's (a label's
   // or a CAM's box larger than the body: body_size.hpp) places the box instead.
   const Eigen::Vector2d measured = measureBodySides(box, lidar, c.covariance.azimuth_step, c.body_size);
-  const Eigen::Vector2d size = frameBodySize(measured, length, width, c.body_size);
+  // This frame places the box with its own measure of a side only where it shows that side whole: the
+  // body seen over some height, the face's far end seen as an end (body_size.hpp).
+  Eigen::Vector2d placing = measured;
+  for (int side = 0; side < 2; ++side) {
+    const double cam = side == 0 ? length : width;
+    if (!(placing[side] > 0.0) || !(cam - placing[side] > c.body_size.frame_tolerance)) continue;  // not placing it anyway
+    double z_lo = 1e9, z_hi = -1e9, el_lo = 1e9, el_hi = -1e9;
+    for (std::size_t i : vehicle_points) {
+      if (c.height_cut && foreground[i].z() >= c.cut_height) continue;
+      z_lo = std::min(z_lo, foreground[i].z());
+      z_hi = std::max(z_hi, foreground[i].z());
+      const double elevation = std::atan2(foreground_z[i] - lidar_z, (foreground[i].head<2>() - lidar).norm());
+      el_lo = std::min(el_lo, elevation);
+      el_hi = std::max(el_hi, elevation);
+    }
+    constexpr double kRingMargin = 0.003;  // rad: a ring's own spread (beam angle's noise, the mount's tilt across a face)
+    const Eigen::Vector2d end = box.alignment_point + (side == 0 ? box.length_face_extent * box.along : box.width_face_extent * box.across);
+    if (!(z_hi - z_lo >= c.body_size.min_seen_height) ||
+        !endSeen(frame, impl_->rotation, impl_->mount.position, box.alignment_point, end, el_lo - kRingMargin, el_hi + kRingMargin,
+                 c.covariance.azimuth_step, c.body_size.end_clearance))
+      placing[side] = -1.0;
+  }
+  const Eigen::Vector2d size = frameBodySize(placing, length, width, c.body_size);
   if (size != Eigen::Vector2d(length, width)) box.center = box.alignment_point + 0.5 * size.x() * box.along + 0.5 * size.y() * box.across;
   const Eigen::Vector2d position = c.align_true_size ? box.center : fit.center;
   if (c.attribute && (position - reference).norm() > c.attribution_radius) return finish(Refusal::kNotAtPosition);
@@ -363,6 +415,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   if (size != Eigen::Vector2d(length, width)) out.covariance += sizeCovariance(sizeDoubt(size, length, width, c.body_size.tolerance), box.yaw);
   out.covariance += sizeCovariance(frameDoubt(measured, size, length, width, c.body_size), box.yaw);
   out.measured_sides = measured;
+  out.placed_size = size;
   return finish(Refusal::kNone);
 }
 

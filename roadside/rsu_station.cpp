@@ -174,8 +174,10 @@ std::vector<StationOutcome> RsuStation::frame(const std::vector<Eigen::Vector3f>
     BodySizeLearner& body = d.bodies.try_emplace(id, d.config.perception.body_size).first->second;
     const Eigen::Vector2d size = body.size(v.length, v.width);
     o.detection = d.perception->detect(points, stamp, centre, heading, size.x(), size.y());
-    const bool measured_size = size != Eigen::Vector2d(v.length, v.width);
-    if (o.detection.found && measured_size) o.detection.covariance += sizeCovariance(body.doubt(v.length, v.width), o.detection.yaw);
+    if (o.detection.found && size != Eigen::Vector2d(v.length, v.width))
+      o.detection.covariance += sizeCovariance(body.doubt(v.length, v.width), o.detection.yaw);
+    // Placed with a side shorter than the CAM's: the station's measures, or this frame's own.
+    const bool measured_size = o.detection.found && o.detection.placed_size != Eigen::Vector2d(v.length, v.width);
     FixConsistency& track = d.tracks.try_emplace(id).first->second;
     if (!o.detection.found) {
       track.miss();

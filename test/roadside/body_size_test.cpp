@@ -74,11 +74,12 @@ TEST(BodySize, MeasuresWithinTheCamsRoundingOrLongerKeepTheCamsSize) {
   EXPECT_EQ(skipped.size(5.0, 2.2), Eigen::Vector2d(5.0, 2.2));
 }
 
-TEST(BodySize, OneFramesMeasureIsUsedOnlyWhenAskedAndFarShorterThanTheCamsButNotSoShortItIsPartial) {
-  EXPECT_EQ(frameBodySize({-1.0, 1.85}, 5.0, 2.2), Eigen::Vector2d(5.0, 2.2)) << "off by default";
-  BodySizeConfig c;
-  c.frame_tolerance = 0.25;
-  EXPECT_EQ(frameBodySize({-1.0, 1.85}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 1.85));
+TEST(BodySize, OneFramesMeasureIsUsedWhereFarShorterThanTheCamsButNotSoShortItIsPartial) {
+  BodySizeConfig off;
+  off.frame_tolerance = 0.0;
+  EXPECT_EQ(frameBodySize({-1.0, 1.85}, 5.0, 2.2, off), Eigen::Vector2d(5.0, 2.2)) << "off";
+  const BodySizeConfig c;
+  EXPECT_EQ(frameBodySize({-1.0, 1.85}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 1.85)) << "on by default";
   EXPECT_EQ(frameBodySize({4.80, 2.0}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 2.2)) << "within the frame's tolerance";
   EXPECT_EQ(frameBodySize({-1.0, 1.5}, 5.0, 2.2, c), Eigen::Vector2d(5.0, 2.2)) << "0.7 m short: a face not seen whole";
   // The width measured: the length kept is doubted by the width's excess.
@@ -137,6 +138,12 @@ TEST(BodySize, AConfigurationOutOfRangeIsRefusedNamingTheKey) {
   c = {};
   c.max_incidence = M_PI;
   refused(c, "max_incidence");
+  c = {};
+  c.min_seen_height = -0.1;
+  refused(c, "min_seen_height");
+  c = {};
+  c.end_clearance = std::nan("");
+  refused(c, "end_clearance");
 }
 
 }  // namespace

@@ -129,6 +129,9 @@ struct VehicleDetection {
   /// What the fit's faces measure of the body's length and width, m (negative where they do not):
   /// body_size.hpp; when found.
   Eigen::Vector2d measured_sides = Eigen::Vector2d::Constant(-1.0);
+  /// The length and width the true-size box was placed with, m: the size asked for, or a side this
+  /// frame measured shorter (BodySizeConfig::frame_tolerance); when found.
+  Eigen::Vector2d placed_size = Eigen::Vector2d::Zero();
   std::size_t foreground_points = 0, fit_points = 0;
   double processing_ms = 0.0;      ///< measured, the whole pipeline
 };
