@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Usage: uncalibrated_start.sh COLOC SCENARIO
-# The first metres of a drive, before the odometry's speed scale and the LiDAR's mounting are learned
-# (config/scenarios/uncalibrated_start.yaml: odometry 1 % high, LiDAR turned 0.6 deg, NDT accurate):
-# with the defaults the fused pose is within 1.1x NDT's own poses over the drive (NDT's covariance from
-# its score: with Autoware's fixed matrix it was 2.7x), and using the learned scale from its first 5 m
-# chord beats waiting for 15 m (docs/experiment.md, "The first metres").
+# The first metres of a drive taken up while moving, before the odometry's speed scale and the LiDAR's
+# mounting are learned (config/scenarios/uncalibrated_start.yaml: odometry 1 % high, LiDAR turned 0.6
+# deg, NDT accurate, the start given by hand and doubted for its first seconds, the street being alike
+# along its length): with the defaults the fused pose is no worse than NDT's own poses over the first
+# 12 m and over the drive, and using the learned scale from its first chord beats waiting for 15 m
+# (docs/experiment.md, "The first metres").
 set -euo pipefail
 coloc=$1
 scenario=$2
@@ -12,13 +13,25 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$coloc" simulate "$scenario" --out "$work/sim" > /dev/null
 mean_of() { sed -n "/$1/ s/.*mean \([0-9.]*\) m, RMSE.*/\1/p" "$2"; }
-"$coloc" fuse "$work/sim/log" --map "$work/sim/map" --config "$work/sim/fuse.yaml" --out "$work/one_chord" > "$work/one_chord.txt"
-sed 's/^pipeline:$/pipeline:\n  speed_scale_min_distance: 15.0/' "$work/sim/fuse.yaml" > "$work/sim/three_chords.yaml"
-grep -q 'speed_scale_min_distance: 15.0' "$work/sim/three_chords.yaml" || { echo "FAIL: fuse.yaml has no pipeline section"; exit 1; }
-"$coloc" fuse "$work/sim/log" --map "$work/sim/map" --config "$work/sim/three_chords.yaml" --out "$work/three_chords" > "$work/three_chords.txt"
-fused=$(mean_of "position error vs ground truth" "$work/one_chord.txt")
-waited=$(mean_of "position error vs ground truth" "$work/three_chords.txt")
-ndt=$(mean_of "ndt  .*its own poses" "$work/one_chord.txt")
-echo "fused $fused m with the scale from one chord, $waited m waiting for three; NDT's own poses $ndt m"
-awk -v a="$fused" -v n="$ndt" 'BEGIN { exit !(a <= 1.1 * n) }' || { echo "FAIL: fused $fused m against NDT's own $ndt m (at most 1.1x)"; exit 1; }
-awk -v a="$fused" -v b="$waited" 'BEGIN { exit !(a < 0.9 * b) }' || { echo "FAIL: one chord $fused m against three chords $waited m"; exit 1; }
+# The mean error within 12 m of the drive's start: the filter's every tick (error.csv), NDT's poses (input_error.csv).
+first_metres() {
+  awk -F, -v source="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+    source != "" && $c["source"] != source { next }
+    !started { x0 = $c["truth_x"]; y0 = $c["truth_y"]; started = 1 }
+    sqrt(($c["truth_x"] - x0)^2 + ($c["truth_y"] - y0)^2) <= 12 { s += $c["error_m"]; n++ }
+    END { if (n) printf "%.4f", s / n }' "$1"
+}
+"$coloc" fuse "$work/sim/log" --map "$work/sim/map" --config "$work/sim/fuse.yaml" --out "$work/fused" > "$work/fused.txt"
+sed 's/^pipeline:$/pipeline:\n  speed_scale_min_distance: 15.0/' "$work/sim/fuse.yaml" > "$work/sim/waited.yaml"
+grep -q 'speed_scale_min_distance: 15.0' "$work/sim/waited.yaml" || { echo "FAIL: fuse.yaml has no pipeline section"; exit 1; }
+"$coloc" fuse "$work/sim/log" --map "$work/sim/map" --config "$work/sim/waited.yaml" --out "$work/waited" > "$work/waited.txt"
+fused=$(mean_of "position error vs ground truth" "$work/fused.txt")
+ndt=$(mean_of "ndt  .*its own poses" "$work/fused.txt")
+fused12=$(first_metres "$work/fused/error.csv" "")
+ndt12=$(first_metres "$work/fused/input_error.csv" ndt)
+waited12=$(first_metres "$work/waited/error.csv" "")
+echo "over the drive: fused $fused m, NDT's own poses $ndt m; over the first 12 m: fused $fused12 m, NDT $ndt12 m, the scale waiting for 15 m $waited12 m"
+[ -n "$fused12" ] && [ -n "$ndt12" ] && [ -n "$waited12" ] || { echo "FAIL: no error within the first 12 m"; exit 1; }
+awk -v a="$fused" -v n="$ndt" 'BEGIN { exit !(a <= n) }' || { echo "FAIL: fused $fused m against NDT's own $ndt m over the drive"; exit 1; }
+awk -v a="$fused12" -v n="$ndt12" 'BEGIN { exit !(a <= n) }' || { echo "FAIL: fused $fused12 m against NDT's own $ndt12 m over the first 12 m"; exit 1; }
+awk -v a="$fused12" -v b="$waited12" 'BEGIN { exit !(a < 0.75 * b) }' || { echo "FAIL: the first chord's scale $fused12 m against waiting for 15 m $waited12 m"; exit 1; }
