@@ -6,30 +6,38 @@ namespace coloc::pipeline {
 
 void SpeedScaleEstimator::addTwist(Stamp stamp, double vx) { odometry_.add(stamp, std::abs(vx)); }
 
-void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position) {
+void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position, double sd) {
   if (!config_.enabled || odometry_.empty() || !position.allFinite()) return;
+  if (!(sd >= 0.0)) sd = 0.0;  // NaN: not stated
   const double odometry = odometry_.at(stamp);
+  const Anchor here{position, odometry, sd};
   if (!anchor_) {
     if (candidate_) {
-      const double moved = (position - candidate_->first).norm(), claimed = odometry - candidate_->second;
+      const double moved = (position - candidate_->position).norm(), claimed = odometry - candidate_->odometry;
       if (claimed >= 0.0 && std::abs(moved - claimed) <= config_.anchor_agreement) anchor_ = candidate_;
     }
-    candidate_ = {position, odometry};
+    candidate_ = here;
     if (!anchor_) return;
   }
-  const double travelled = odometry - anchor_->second;
+  const double travelled = odometry - anchor_->odometry;
   if (travelled < config_.chord) {
-    if (travelled < 0.0) anchor_ = {position, odometry};  // a pose older than the anchor: start again
+    if (travelled < 0.0) anchor_ = here;  // a pose older than the anchor: start again
     return;
   }
-  const double chord = (position - anchor_->first).norm();
-  anchor_ = {position, odometry};
+  const double chord = (position - anchor_->position).norm();
+  // The chord's weight: its two ends' stated variance, relative to a well-placed pair's.
+  double weight = 1.0;
+  if (config_.pose_sd_floor > 0.0) {
+    const double floor = config_.pose_sd_floor * config_.pose_sd_floor;
+    weight = 2.0 * floor / (2.0 * floor + anchor_->sd * anchor_->sd + sd * sd);
+  }
+  anchor_ = here;
   const double ratio = chord / travelled;
   if (!(std::abs(ratio - 1.0) <= 3.0 * config_.max_error)) return;  // a jump of NDT, not a scale
   // Forgetting by distance: a comparison made `memory` metres of travel ago weighs 1/e.
   const double keep = std::exp(-travelled / config_.memory);
-  weighted_pose_ = keep * weighted_pose_ + chord;
-  weighted_odometry_ = keep * weighted_odometry_ + travelled;
+  weighted_pose_ = keep * weighted_pose_ + weight * chord;
+  weighted_odometry_ = keep * weighted_odometry_ + weight * travelled;
   compared_ += travelled;
   const double estimate = weighted_pose_ / weighted_odometry_;
   if (std::abs(estimate - 1.0) <= config_.max_error) estimate_ = estimate;
