@@ -572,9 +572,8 @@ struct Pipeline::Impl {
     const fusion::IntegrityStatus& integrity = localizer.integrity();
     if (!feedPose(ndt_id, pose, &alone).rejected() && integrity.state != fusion::LocalizationState::kLost) {
       // NDT's own word on the pose, before any floor or check here widened it.
-      const Eigen::Matrix2d stated = outcome.pose.covariance.topLeftCorner<2, 2>();
-      const double stated_sd = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(stated).eigenvalues().maxCoeff()));
-      speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>(), stated_sd);
+      speed_scale.addPose(outcome.pose.stamp, outcome.pose.pose.position.head<2>(),
+                          std::sqrt(largestPrincipalVariance(outcome.pose.covariance.topLeftCorner<2, 2>())));
       yaw_rate_bias.addPose(outcome.pose.stamp, raw_yaw);
       mount_yaw.addPose(outcome.pose.pose.position.head<2>(), raw_yaw);
     }

@@ -383,17 +383,23 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // This frame places the box with its own measure of a side only where it shows that side whole: the
   // body seen over some height, the face's far end seen as an end (body_size.hpp).
   Eigen::Vector2d placing = measured;
+  // The heights over the road and the elevations from the LiDAR the fitted part of the body was seen
+  // at, found once, when a side would be placed.
+  double z_lo = 1e9, z_hi = -1e9, el_lo = 1e9, el_hi = -1e9;
+  bool seen_found = false;
   for (int side = 0; side < 2; ++side) {
     const double cam = side == 0 ? length : width;
-    if (!(placing[side] > 0.0) || !(cam - placing[side] > c.body_size.frame_tolerance)) continue;  // not placing it anyway
-    double z_lo = 1e9, z_hi = -1e9, el_lo = 1e9, el_hi = -1e9;
-    for (std::size_t i : vehicle_points) {
-      if (c.height_cut && foreground[i].z() >= c.cut_height) continue;
-      z_lo = std::min(z_lo, foreground[i].z());
-      z_hi = std::max(z_hi, foreground[i].z());
-      const double elevation = std::atan2(foreground_z[i] - lidar_z, (foreground[i].head<2>() - lidar).norm());
-      el_lo = std::min(el_lo, elevation);
-      el_hi = std::max(el_hi, elevation);
+    if (!(c.body_size.frame_tolerance > 0.0) || !(placing[side] > 0.0) || !(cam - placing[side] > c.body_size.frame_tolerance)) continue;
+    if (!seen_found) {
+      seen_found = true;
+      for (std::size_t i : vehicle_points) {
+        if (c.height_cut && foreground[i].z() >= c.cut_height) continue;
+        z_lo = std::min(z_lo, foreground[i].z());
+        z_hi = std::max(z_hi, foreground[i].z());
+        const double elevation = std::atan2(foreground_z[i] - lidar_z, (foreground[i].head<2>() - lidar).norm());
+        el_lo = std::min(el_lo, elevation);
+        el_hi = std::max(el_hi, elevation);
+      }
     }
     constexpr double kRingMargin = 0.003;  // rad: a ring's own spread (beam angle's noise, the mount's tilt across a face)
     const Eigen::Vector2d end = box.alignment_point + (side == 0 ? box.length_face_extent * box.along : box.width_face_extent * box.across);

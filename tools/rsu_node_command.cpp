@@ -13,9 +13,8 @@
 #include <mutex>
 #include <thread>
 
-#include <Eigen/Eigenvalues>
-
 #include "coloc/core/error.hpp"
+#include "coloc/core/principal_variances.hpp"
 #include "coloc/io/bag_reader.hpp"
 #include "coloc/io/bag_writer.hpp"
 #include "coloc/io/ros_messages.hpp"
@@ -195,7 +194,7 @@ void runOffline(const NodeSettings& s, const rsu_client::RsuRegistry& registry, 
               error_series.x.push_back(o.distance);
               error_series.y.push_back(error);
               sd_series.x.push_back(o.distance);
-              sd_series.y.push_back(std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(d.covariance).eigenvalues().maxCoeff()));
+              sd_series.y.push_back(std::sqrt(largestPrincipalVariance(d.covariance)));
             }
           }
           csv << formatSeconds(seen) << "," << o.station_id << "," << (d.found ? "fix" : roadside::toString(d.refusal)) << "," << d.position.x() << ","

@@ -2,6 +2,9 @@
 // A planar covariance changed direction by direction: its principal variances mapped, its axes kept.
 // Raising a covariance "to at least" a figure means it in every direction, not on the x and y axes
 // alone (a fit sure along the road and unsure across it keeps that shape), and one solver does it.
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
@@ -22,6 +25,13 @@ Eigen::Matrix2d mapPrincipalVariances(const Eigen::Matrix2d& covariance, F f) {
 /// Every direction's variance at least `variance`.
 inline Eigen::Matrix2d principalVariancesAtLeast(const Eigen::Matrix2d& covariance, double variance) {
   return mapPrincipalVariances(covariance, [variance](double v) { return v < variance ? variance : v; });
+}
+
+/// The largest variance in any direction (the larger eigenvalue of the symmetric part), at least 0;
+/// NaN if the covariance has no real eigen-decomposition.
+inline double largestPrincipalVariance(const Eigen::Matrix2d& covariance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> e(0.5 * (covariance + covariance.transpose()));
+  return e.info() == Eigen::Success ? std::max(0.0, e.eigenvalues()[1]) : std::nan("");
 }
 
 }  // namespace coloc
