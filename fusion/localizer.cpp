@@ -564,6 +564,13 @@ std::optional<Estimate> Localizer::estimate() {
   return impl_->estimate();
 }
 
+Pose measuredPose(const Estimate& estimate) {
+  Pose pose = estimate.pose;
+  const Eigen::Vector3d rpy = rollPitchYaw(pose.orientation);
+  pose.orientation = quaternionFromRollPitchYaw(rpy[0], rpy[1], wrapAngle(rpy[2] - estimate.yaw_bias));
+  return pose;
+}
+
 std::optional<Estimate> Localizer::estimateAt(Stamp stamp) {
   if (!impl_->initialized) return std::nullopt;
   return impl_->estimateAt(stamp);

@@ -163,8 +163,7 @@ struct LiveLocalizer::Impl {
       if (biased_pose_writer.matchedReaders() > 0) {
         // The yaw as the pose sources measure it, before the filter's yaw bias: what NDT starts from.
         io::StampedPose biased = pose;
-        const Eigen::Vector3d rpy = rollPitchYaw(e.pose.orientation);
-        biased.measurement.pose.orientation = quaternionFromRollPitchYaw(rpy[0], rpy[1], rpy[2] - e.yaw_bias);
+        biased.measurement.pose.orientation = fusion::measuredPose(e).orientation;
         biased_pose_writer.write(io::encodePoseWithCovarianceStamped(biased));
       }
       if (tf_writer.matchedReaders() > 0) {

@@ -336,7 +336,7 @@ struct Pipeline::Impl {
   // searched by NDT near the filter's own, or the direction of travel.
   void tryRecover() {
     const std::string why = localizer.integrity().reason;
-    const double heading = rollPitchYaw(localizer.estimate()->pose.orientation)[2];
+    const double heading = rollPitchYaw(fusion::measuredPose(*localizer.estimate()).orientation)[2];
     std::lock_guard<std::mutex> using_ndt(ndt_use);
     std::string waiting;
     const std::optional<StartPose> found = initializer.tryStart(ndt.get(), heading, waiting);
@@ -601,11 +601,13 @@ struct Pipeline::Impl {
       // Where the filter models the bias NDT's poses share, NDT still starts from the position without
       // it: in a weak direction the filter's odometry-held position is the better start (started from
       // position + bias on site D's cutting, NDT erred 13.0 cm instead of 11.1).
-      const std::optional<fusion::Estimate> guess = localizer.estimateAt(scan->stamp);
+      std::optional<fusion::Estimate> guess = localizer.estimateAt(scan->stamp);
       if (!guess) {
         ++report.scans_without_guess;
         return;
       }
+      // With the yaw NDT measures, not the heading of motion (fusion::measuredPose says why).
+      guess->pose = fusion::measuredPose(*guess);
       if (check_start && scan->stamp >= next_start_check) {
         if (next_start_check == 0) start_check_end = scan->stamp + fromSeconds(config.pipeline.start_check_duration);
         if (scan->stamp <= start_check_end) checkStart(*scan, *guess);

@@ -42,6 +42,13 @@ struct Estimate {
   LocalizationState localization = LocalizationState::kInitialising;
 };
 
+/// The estimate's pose with the yaw as the pose sources measure it, before the yaw bias (the EKF's
+/// own yaw state): where a map matcher must start. Started from the heading of motion, a scan match
+/// the scene holds loosely in yaw returns that heading, the filter takes it as a measured yaw one yaw
+/// bias off, and in a bend the heading runs away by the bias at every scan (Autoware's NDT likewise
+/// starts from the EKF's biased pose).
+Pose measuredPose(const Estimate& estimate);
+
 struct SourceReport {
   std::string name;
   SourceKind kind;
