@@ -26,7 +26,7 @@ FixChecker checkerOfStation(std::optional<std::uint32_t> station) {
 }
 
 RsuFix fixFor(std::optional<std::uint32_t> station, Stamp stamp, double x) {
-  RsuFix fix{stamp, "rsu_a", x, 0.0, std::nullopt, std::nullopt};
+  RsuFix fix{stamp, "rsu_a", x, 0.0, std::nullopt, std::nullopt, std::nullopt};
   fix.station_id = station;
   return fix;
 }
@@ -82,7 +82,7 @@ TEST(FixChecker, AnAddressNotAStationIdIsRefusedAsBadAddress) {
 
 TEST(FixChecker, ValidFixBecomesATwoDimensionalMeasurementWithInfiniteElsewhere) {
   FixChecker c = checker();
-  const FixVerdict v = c.check({kNow - 20'000'000, "rsu_a", 110.0, 2.0, std::nullopt, std::nullopt}, kNow);
+  const FixVerdict v = c.check({kNow - 20'000'000, "rsu_a", 110.0, 2.0, std::nullopt, std::nullopt, std::nullopt}, kNow);
   ASSERT_TRUE(v.accepted()) << v.detail;
   EXPECT_EQ(v.measurement.stamp, kNow - 20'000'000);  // capture time, not arrival
   EXPECT_EQ(v.measurement.covariance(0, 0), 0.01486);
@@ -99,13 +99,13 @@ TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
     FixRejection reason;
   };
   const Case cases[] = {
-      {{kNow, "rsu_z", 100, 0, std::nullopt, std::nullopt}, FixRejection::kUnknownRsu},
-      {{kNow, "rsu_a", nan, 0, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
-      {{kNow, "rsu_a", 100, kInfinity, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
+      {{kNow, "rsu_z", 100, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kUnknownRsu},
+      {{kNow, "rsu_a", nan, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
+      {{kNow, "rsu_a", 100, kInfinity, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
       {{kNow, "rsu_a", 100, 0, nan, std::nullopt}, FixRejection::kNonFinite},
-      {{kNow, "rsu_a", 140, 0, std::nullopt, std::nullopt}, FixRejection::kOutOfCoverage},
-      {{kNow - 2 * kNanosPerSecond, "rsu_a", 100, 0, std::nullopt, std::nullopt}, FixRejection::kStale},
-      {{kNow + kNanosPerSecond, "rsu_a", 100, 0, std::nullopt, std::nullopt}, FixRejection::kFromFuture},
+      {{kNow, "rsu_a", 140, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kOutOfCoverage},
+      {{kNow - 2 * kNanosPerSecond, "rsu_a", 100, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kStale},
+      {{kNow + kNanosPerSecond, "rsu_a", 100, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kFromFuture},
   };
   for (const Case& k : cases) {
     const FixVerdict v = c.check(k.fix, kNow);
@@ -113,8 +113,8 @@ TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
     EXPECT_NE(v.detail.find(toString(k.reason)), std::string::npos) << v.detail;
     EXPECT_NE(v.detail.find(k.fix.rsu_id), std::string::npos) << v.detail;
   }
-  EXPECT_TRUE(c.check({kNow - 1000, "rsu_a", 101, 0, std::nullopt, std::nullopt}, kNow).accepted());
-  EXPECT_EQ(c.check({kNow - 1000, "rsu_a", 101, 0, std::nullopt, std::nullopt}, kNow + 5).rejection, FixRejection::kDuplicate);
+  EXPECT_TRUE(c.check({kNow - 1000, "rsu_a", 101, 0, std::nullopt, std::nullopt, std::nullopt}, kNow).accepted());
+  EXPECT_EQ(c.check({kNow - 1000, "rsu_a", 101, 0, std::nullopt, std::nullopt, std::nullopt}, kNow + 5).rejection, FixRejection::kDuplicate);
   const FixCounters& a = c.counters().at("rsu_a");
   EXPECT_EQ(a.non_finite, 3u);
   EXPECT_EQ(a.out_of_coverage, 1u);
@@ -127,7 +127,7 @@ TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
 
 // A fix as a message carries it: map frame, the registry's VLP-16 variance on x and y, +inf elsewhere.
 RsuFix sentFix(Stamp stamp, double x) {
-  RsuFix fix{stamp, "rsu_a", x, 0.0, std::nullopt, std::nullopt};
+  RsuFix fix{stamp, "rsu_a", x, 0.0, std::nullopt, std::nullopt, std::nullopt};
   SentFields sent;
   sent.frame_id = "map";
   sent.nanosec = static_cast<std::uint32_t>(stamp % kNanosPerSecond);
@@ -274,11 +274,11 @@ TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {
       l.advanceTo(now);
       if (k % 5 != 0 || k == 20) continue;  // 10 Hz; the fix of tick 20 is lost
       if (delayed && k == 10) continue;  // held back by the link
-      const FixVerdict v = checker_local.check({now, "rsu_a", 105.0, 1.0, std::nullopt, std::nullopt}, now);
+      const FixVerdict v = checker_local.check({now, "rsu_a", 105.0, 1.0, std::nullopt, std::nullopt, std::nullopt}, now);
       EXPECT_TRUE(l.feedPose("rsu_a", v.measurement).applied());
     }
     if (delayed) {  // the fix of tick 10 arrives now, at tick 30
-      const FixVerdict v = checker_local.check({kNow + 10 * 20'000'000LL, "rsu_a", 105.0, 1.0, std::nullopt, std::nullopt}, kNow + 30 * 20'000'000LL);
+      const FixVerdict v = checker_local.check({kNow + 10 * 20'000'000LL, "rsu_a", 105.0, 1.0, std::nullopt, std::nullopt, std::nullopt}, kNow + 30 * 20'000'000LL);
       EXPECT_TRUE(v.accepted());
       EXPECT_TRUE(l.feedPose("rsu_a", v.measurement).applied());
     }
