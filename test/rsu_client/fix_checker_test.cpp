@@ -102,7 +102,7 @@ TEST(FixChecker, EveryInvalidFixIsRejectedWithItsReasonAndCounted) {
       {{kNow, "rsu_z", 100, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kUnknownRsu},
       {{kNow, "rsu_a", nan, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
       {{kNow, "rsu_a", 100, kInfinity, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
-      {{kNow, "rsu_a", 100, 0, nan, std::nullopt}, FixRejection::kNonFinite},
+      {{kNow, "rsu_a", 100, 0, nan, std::nullopt, std::nullopt}, FixRejection::kNonFinite},
       {{kNow, "rsu_a", 140, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kOutOfCoverage},
       {{kNow - 2 * kNanosPerSecond, "rsu_a", 100, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kStale},
       {{kNow + kNanosPerSecond, "rsu_a", 100, 0, std::nullopt, std::nullopt, std::nullopt}, FixRejection::kFromFuture},
