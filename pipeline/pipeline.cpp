@@ -643,6 +643,7 @@ struct Pipeline::Impl {
       if (std::isfinite(t.covariance(5, 5))) {
         yaw_rate_bias.addTwist(t.stamp, t.angular.z());
         t.angular.z() -= yaw_rate_bias.bias();
+        travel_check.addYawRate(t.stamp, t.angular.z());
       }
       initializer.setTwist(t);
       if (on_twist_input) on_twist_input(source_names[twist->source], t, twist->twist);
