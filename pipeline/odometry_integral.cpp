@@ -1,5 +1,6 @@
 #include "odometry_integral.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace coloc::pipeline {
@@ -14,8 +15,7 @@ void OdometryIntegral::add(Stamp stamp, double rate) {
 }
 
 double OdometryIntegral::at(Stamp stamp) const {
-  auto after = marks_.begin();
-  while (after != marks_.end() && after->stamp < stamp) ++after;
+  const auto after = std::lower_bound(marks_.begin(), marks_.end(), stamp, [](const Mark& m, Stamp s) { return m.stamp < s; });
   if (after == marks_.begin()) return marks_.front().integral - marks_.front().rate * toSeconds(marks_.front().stamp - stamp);
   if (after == marks_.end()) return marks_.back().integral + marks_.back().rate * toSeconds(stamp - marks_.back().stamp);
   const auto before = after - 1;

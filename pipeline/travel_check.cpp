@@ -40,8 +40,8 @@ void TravelCheck::addYawRate(Stamp stamp, double yaw_rate) {
 }
 
 Eigen::Vector2d TravelCheck::odometryChord(Stamp from, Stamp to, double from_yaw, double to_yaw) const {
-  const double travelled = distance_.at(to) - distance_.at(from);
   if (heading_.empty()) {
+    const double travelled = distance_.at(to) - distance_.at(from);
     // No yaw rate: an arc of constant curvature between NDT's two headings. Its chord lies along the
     // mean heading and is shorter than the arc by sin(h) / h, h half the turn.
     const double half_turn = 0.5 * std::remainder(to_yaw - from_yaw, 2.0 * M_PI);
@@ -57,13 +57,13 @@ Eigen::Vector2d TravelCheck::odometryChord(Stamp from, Stamp to, double from_yaw
   const double start = heading_.at(from);
   const double correction = std::remainder(to_yaw - from_yaw, 2.0 * M_PI) - (heading_.at(to) - start);
   Eigen::Vector2d path = Eigen::Vector2d::Zero();
-  double s0 = distance_.at(from);
-  for (int k = 0; k < kSteps; ++k) {
-    const Stamp a = from + (to - from) * k / kSteps, b = from + (to - from) * (k + 1) / kSteps;
-    const double s1 = distance_.at(b);
-    const double heading = from_yaw + 0.5 * (heading_.at(a) + heading_.at(b)) - start + correction * (k + 0.5) / kSteps;
+  double s0 = distance_.at(from), h0 = start;
+  for (int k = 1; k <= kSteps; ++k) {
+    const Stamp b = from + (to - from) * k / kSteps;
+    const double s1 = distance_.at(b), h1 = heading_.at(b);
+    const double heading = from_yaw + 0.5 * (h0 + h1) - start + correction * (k - 0.5) / kSteps;
     path += (s1 - s0) * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-    s0 = s1;
+    s0 = s1, h0 = h1;
   }
   return path;
 }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -183,6 +184,9 @@ TEST(TravelCheck, OneBadMatchAtAChordsStartDoesNotWidenThePosesAfterIt) {
 TEST(TravelCheck, NonFiniteOrOutOfOrderPosesAreNeitherComparedNorKept) {
   TravelCheck check;
   for (int k = 0; k <= 100; ++k) check.addSpeed(at(0.02 * k), 10.0);
+  // Yaw rates that are not finite are not integrated: the odometry's path stays straight.
+  for (int k = 0; k <= 100; ++k) check.addYawRate(at(0.02 * k), k % 2 ? std::nan("") : 0.0);
+  check.addYawRate(at(2.5), std::numeric_limits<double>::infinity());
   EXPECT_FALSE(check.check(at(0.1), Eigen::Vector2d(1.0, 0.0), 0.0).has_value());
   EXPECT_FALSE(check.check(at(0.2), Eigen::Vector2d(2.0, 0.0), 0.0).has_value());
   EXPECT_FALSE(check.check(at(0.9), Eigen::Vector2d(std::nan(""), 0.0), 0.0).has_value());

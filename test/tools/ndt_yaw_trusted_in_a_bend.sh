@@ -6,19 +6,13 @@
 # the filter learns of the LiDAR's mounting): from the heading of motion, each scan handed the bias
 # back as a measured yaw, and the heading ran away by the bias at every scan (13.5 m mean error on the
 # experiment's site B drive). The fused pose must stay no worse than NDT's own poses.
-set -euo pipefail
-coloc=$1
-scenario=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-"$coloc" simulate "$scenario" --out "$work/sim" > /dev/null
+source "$(dirname "$0")/simulated_drive.sh"
 cat "$work/sim/fuse.yaml" - > "$work/sim/tight_yaw.yaml" <<'YAML'
 ndt:
   fixed_covariance: [0.0225, 0.0225, 0.0225, 0.000625, 0.000625, 1e-6]
   covariance_floor: [0.0001, 0.0001, 0.0225, 0.000625, 0.000625, 1e-6]
 YAML
 "$coloc" fuse "$work/sim/log" --map "$work/sim/map" --config "$work/sim/tight_yaw.yaml" --out "$work/fused" > "$work/fused.txt"
-mean_of() { sed -n "/$1/ s/.*mean \([0-9.]*\) m, RMSE.*/\1/p" "$2"; }
 fused=$(mean_of "position error vs ground truth" "$work/fused.txt")
 ndt=$(mean_of "ndt  .*its own poses" "$work/fused.txt")
 echo "NDT's yaw at 1e-6 rad^2 through the bend: fused $fused m, NDT's own poses $ndt m"

@@ -3,12 +3,7 @@
 # A recording whose recorder died: the twin's log as MCAP, cut in the middle of a chunk. coloc fuse
 # refuses it and says how to read it; with --recover it fuses the messages before the cut, and
 # coloc convert --recover turns it into a closed recording that fuses to the same trajectory.
-set -euo pipefail
-coloc=$1
-scenario=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-"$coloc" simulate "$scenario" --out "$work/sim" > /dev/null
+source "$(dirname "$0")/simulated_drive.sh"
 "$coloc" convert "$work/sim/log" "$work/whole.mcap" > /dev/null
 size=$(stat -c %s "$work/whole.mcap")
 head -c $((size * 2 / 3)) "$work/whole.mcap" > "$work/cut.mcap"

@@ -6,13 +6,7 @@
 # along its length): with the defaults the fused pose is no worse than NDT's own poses over the first
 # 12 m and over the drive, and using the learned scale from its first chord beats waiting for 15 m
 # (docs/experiment.md, "The first metres").
-set -euo pipefail
-coloc=$1
-scenario=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-"$coloc" simulate "$scenario" --out "$work/sim" > /dev/null
-mean_of() { sed -n "/$1/ s/.*mean \([0-9.]*\) m, RMSE.*/\1/p" "$2"; }
+source "$(dirname "$0")/simulated_drive.sh"
 # The mean error within 12 m of the drive's start: the filter's every tick (error.csv), NDT's poses (input_error.csv).
 first_metres() {
   awk -F, -v source="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
