@@ -1,6 +1,7 @@
 #include "measurement_update.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "motion_model.hpp"
 
@@ -137,6 +138,37 @@ bool applyWithBias(FilterState& state, const Model& mdl, const Innovation& in) {
 
 Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale) {
   return innovationWith(state, record, model(state, record), scale);
+}
+
+std::array<double, 5> componentNis(const FilterState& state, const UpdateRecord& record) {
+  std::array<double, 5> out;
+  out.fill(std::numeric_limits<double>::quiet_NaN());
+  if (record.m == 0) return out;
+  const Innovation in = innovation(state, record, 1.0);
+  const auto ratio = [](double e, double s) { return s > 0.0 ? e * e / s : std::numeric_limits<double>::quiet_NaN(); };
+  int row_x = -1, row_y = -1;
+  for (int i = 0; i < in.m; ++i) {
+    const int si = record.index[i];
+    if (si == kX) row_x = i;
+    if (si == kY) row_y = i;
+    if (si == kYaw) out[kNisYaw] = ratio(in.e[i], in.S(i, i));
+    if (si == kVx) out[kNisSpeed] = ratio(in.e[i], in.S(i, i));
+    if (si == kWz) out[kNisYawRate] = ratio(in.e[i], in.S(i, i));
+  }
+  if (row_x >= 0 && row_y >= 0) {
+    // Turned into the vehicle's frame: along = (cos, sin) . e, across = (-sin, cos) . e.
+    const double c = std::cos(state.x[kYaw]), s = std::sin(state.x[kYaw]);
+    const Eigen::Vector2d e(in.e[row_x], in.e[row_y]);
+    Eigen::Matrix2d S;
+    S << in.S(row_x, row_x), in.S(row_x, row_y), in.S(row_y, row_x), in.S(row_y, row_y);
+    Eigen::Matrix2d turn;
+    turn << c, s, -s, c;
+    const Eigen::Vector2d e_body = turn * e;
+    const Eigen::Matrix2d S_body = turn * S * turn.transpose();
+    out[kNisAlong] = ratio(e_body.x(), S_body(0, 0));
+    out[kNisAcross] = ratio(e_body.y(), S_body(1, 1));
+  }
+  return out;
 }
 
 double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) {

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "coloc/fusion/filter_state.hpp"
+#include "coloc/fusion/verdict.hpp"
 
 namespace coloc::fusion {
 
@@ -33,6 +34,10 @@ struct Innovation {
   Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
 };
 Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale);
+
+/// Each measured component's e_i^2 / S_ii alone (NisComponent order; NaN where not measured or S_ii
+/// is not positive), x and y turned to along and across the state's yaw where both are measured.
+std::array<double, 5> componentNis(const FilterState& state, const UpdateRecord& record);
 
 /// e^T S^-1 e with the measurement's own covariance; +inf if S is not positive definite.
 double mahalanobisSquared(const FilterState& state, const UpdateRecord& record);

@@ -58,6 +58,17 @@ std::string Verdict::message() const {
   return out.str();
 }
 
+const char* toString(NisComponent component) {
+  switch (component) {
+    case kNisAlong: return "along";
+    case kNisAcross: return "across";
+    case kNisYaw: return "yaw";
+    case kNisSpeed: return "speed";
+    case kNisYawRate: return "yaw_rate";
+  }
+  return "?";
+}
+
 std::pair<double, double> nisBand(std::uint64_t dof) {
   if (dof == 0) return {0.0, 0.0};
   // Wilson-Hilferty: (X/k)^(1/3) is nearly normal with mean 1 - 2/(9k) and variance 2/(9k); the

@@ -14,12 +14,22 @@ std::string sourcesJson(const std::vector<fusion::SourceReport>& sources) {
         {"not_initialized", c.not_initialized}, {"numerical", c.numerical}, {"pending", c.pending},
         {"smoothing_shortened", c.smoothing_shortened}, {"gate_recovered", c.gate_recovered}};
     const auto band = fusion::nisBand(c.nis_dof);
-    const nlohmann::ordered_json nis = {{"samples", c.nis_samples},
-                                        {"dof", c.nis_dof},
-                                        {"mean_per_dof", c.nis_dof ? c.nis_sum / static_cast<double>(c.nis_dof) : 0.0},
-                                        {"band_95", {band.first, band.second}},
-                                        {"above_97_5", c.nis_above},
-                                        {"below_2_5", c.nis_below}};
+    nlohmann::ordered_json nis = {{"samples", c.nis_samples},
+                                  {"dof", c.nis_dof},
+                                  {"mean_per_dof", c.nis_dof ? c.nis_sum / static_cast<double>(c.nis_dof) : 0.0},
+                                  {"band_95", {band.first, band.second}},
+                                  {"above_97_5", c.nis_above},
+                                  {"below_2_5", c.nis_below}};
+    // Each component measured: its mean e_i^2 / S_ii and that mean's 95 % band.
+    nlohmann::ordered_json parts = nlohmann::ordered_json::object();
+    for (std::size_t k = 0; k < c.nis_component_sum.size(); ++k) {
+      const std::uint64_t n = c.nis_component_samples[k];
+      if (n == 0) continue;
+      const auto part_band = fusion::nisBand(n);
+      parts[fusion::toString(static_cast<fusion::NisComponent>(k))] = {
+          {"samples", n}, {"mean", c.nis_component_sum[k] / static_cast<double>(n)}, {"band_95", {part_band.first, part_band.second}}};
+    }
+    nis["per_component"] = parts;
     list.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"}, {"counters", counters}, {"nis", nis}});
   }
   return list.dump();

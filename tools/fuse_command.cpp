@@ -59,6 +59,15 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     const double n = static_cast<double>(c.nis_samples);
     std::printf("  %-22s %8llu %13.3f %7.3f-%-7.3f %9.1f%% %9.1f%%\n", s.name.c_str(), (unsigned long long)c.nis_samples,
                 c.nis_sum / static_cast<double>(c.nis_dof), band.first, band.second, 100.0 * c.nis_above / n, 100.0 * c.nis_below / n);
+    std::string parts;
+    for (std::size_t k = 0; k < c.nis_component_sum.size(); ++k) {
+      if (!c.nis_component_samples[k]) continue;
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%s%s %.3g", parts.empty() ? "" : ", ", fusion::toString(static_cast<fusion::NisComponent>(k)),
+                    c.nis_component_sum[k] / static_cast<double>(c.nis_component_samples[k]));
+      parts += buf;
+    }
+    if (!parts.empty()) std::printf("  %-22s %8s %s\n", "", "", (parts + " (each component alone)").c_str());
   }
   for (const auto& [id, c] : r.fixes) std::printf("  %s\n", fixLine(id, r.pipeline_report).c_str());
   std::printf("  localization: %s\n", localizationLine(r.pipeline_report).c_str());

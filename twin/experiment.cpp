@@ -245,7 +245,11 @@ void runJob(Job& job) {
     if (auto e = r.input_errors.find(pipeline::kNdtSource); e != r.input_errors.end()) job.ndt_errors = std::move(e->second);
   const auto fused = [&](const std::string& topic) { return std::find(job.fix_topics.begin(), job.fix_topics.end(), topic) != job.fix_topics.end(); };
   for (const fusion::SourceReport& s : r.sources)
-    if (s.name == pipeline::kNdtSource) job.run.ndt_nis_sum = s.counters.nis_sum, job.run.ndt_nis_dof = s.counters.nis_dof;
+    if (s.name == pipeline::kNdtSource) {
+      job.run.ndt_nis_sum = s.counters.nis_sum, job.run.ndt_nis_dof = s.counters.nis_dof;
+      for (std::size_t k = 0; k < job.run.ndt_nis_component_sum.size(); ++k)
+        job.run.ndt_nis_component_sum[k] = s.counters.nis_component_sum[k], job.run.ndt_nis_component_samples[k] = s.counters.nis_component_samples[k];
+    }
   for (const fusion::SourceReport& s : r.sources)
     if (std::find(job.fix_sources.begin(), job.fix_sources.end(), s.name) != job.fix_sources.end()) {
       job.run.fixes_applied += s.counters.applied;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -454,6 +455,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     }
     // NDT's normalized innovation squared per site and configuration, the main drives' ideal network.
     std::map<std::pair<std::string, std::string>, std::pair<double, std::uint64_t>> nis;
+    std::map<std::pair<std::string, std::string>, std::array<std::pair<double, std::uint64_t>, 3>> nis_parts;
     std::set<std::string> present;
     for (const ExperimentRun& r : results.runs) {
       if (!r.variant.empty() || r.delay != 0.0 || r.loss != 0.0 || r.ndt_nis_dof == 0) continue;
@@ -461,6 +463,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
       auto& n = nis[{r.site, configuration}];
       n.first += r.ndt_nis_sum;
       n.second += r.ndt_nis_dof;
+      auto& parts = nis_parts[{r.site, configuration}];
+      for (std::size_t k = 0; k < parts.size(); ++k) parts[k].first += r.ndt_nis_component_sum[k], parts[k].second += r.ndt_nis_component_samples[k];
       present.insert(configuration);
     }
     std::vector<std::string> configurations;  // NDT only first, then each LiDAR as configured
@@ -468,27 +472,37 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     for (const std::string& lidar : c.lidars)
       if (present.count("NDT + " + lidar)) configurations.push_back("NDT + " + lidar);
     if (!nis.empty()) {
+      // One row per site, one cell per configuration ("-" where the site has none).
+      const auto by_site = [&](const std::function<std::string(const std::string&, const std::string&)>& cell) {
+        ndt_md << "| site |";
+        for (const std::string& configuration : configurations) ndt_md << " " << configuration << " |";
+        ndt_md << "\n|---|";
+        for (std::size_t k = 0; k < configurations.size(); ++k) ndt_md << "---|";
+        ndt_md << "\n";
+        for (const SiteInfo& site : results.sites) {
+          ndt_md << "| " << site.name << " |";
+          for (const std::string& configuration : configurations) ndt_md << " " << cell(site.name, configuration) << " |";
+          ndt_md << "\n";
+        }
+      };
       ndt_md << "\n**NDT's normalized innovation squared** per degree of freedom in the filter (d^2 = e' (H P H' + R)^-1 e at its "
                 "first use; 1 when the filter's and NDT's covariances are honest), the main drives on the ideal network, each with "
-                "the band it lies in 95 % of the time when they are:\n\n| site |";
-      for (const std::string& configuration : configurations) ndt_md << " " << configuration << " |";
-      ndt_md << "\n|---|";
-      for (std::size_t k = 0; k < configurations.size(); ++k) ndt_md << "---|";
-      ndt_md << "\n";
-      for (const SiteInfo& site : results.sites) {
-        ndt_md << "| " << site.name << " |";
-        for (const std::string& configuration : configurations) {
-          const auto found = nis.find({site.name, configuration});
-          if (found == nis.end()) {
-            ndt_md << " - |";
-            continue;
-          }
-          const auto band = fusion::nisBand(found->second.second);
-          ndt_md << fmt(" %.2f", found->second.first / static_cast<double>(found->second.second)) << fmt(" (%.2f-", band.first)
-                 << fmt("%.2f) |", band.second);
-        }
-        ndt_md << "\n";
-      }
+                "the band it lies in 95 % of the time when they are:\n\n";
+      by_site([&](const std::string& site, const std::string& configuration) {
+        const auto found = nis.find({site, configuration});
+        if (found == nis.end()) return std::string("-");
+        const auto band = fusion::nisBand(found->second.second);
+        return fmt("%.2f", found->second.first / static_cast<double>(found->second.second)) + fmt(" (%.2f-", band.first) + fmt("%.2f)", band.second);
+      });
+      // The whole figure can hide one direction trusted too little behind another trusted too much.
+      ndt_md << "\nThe same per component (each e_i^2 / S_ii alone, 1 when honest): along the vehicle / across it / yaw:\n\n";
+      by_site([&](const std::string& site, const std::string& configuration) {
+        const auto found = nis_parts.find({site, configuration});
+        if (found == nis_parts.end()) return std::string("-");
+        std::string cell;
+        for (const auto& [sum, n] : found->second) cell += (cell.empty() ? "" : " / ") + (n ? fmt("%.3g", sum / static_cast<double>(n)) : std::string("-"));
+        return cell;
+      });
     }
   }
 

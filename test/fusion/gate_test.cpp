@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "drive.hpp"
 
@@ -121,13 +122,14 @@ namespace coloc::fusion {
 namespace {
 
 // Fixes drawn with the spread their covariance states, `stated_over_true` times it, fed to a filter
-// standing still; the source's normalized innovation squared as counted.
-SourceCounters nisOfFixes(double stated_over_true) {
+// standing still and heading `yaw`; the spread along the map's y is `y_over_x` times that along x.
+// The fix source's and the odometry's counters.
+std::pair<SourceCounters, SourceCounters> countersOfFixes(double stated_over_true, double yaw = 0.0, double y_over_x = 1.0) {
   Localizer filter;
   const SourceId odom = filter.addTwistSource("odom");
   const SourceId rsu = filter.addPoseSource("/rsu/a/fix", 1, true);
   Stamp now = testing::kStart;
-  filter.initialize(testing::planarPose(now, 0.0, 0.0, 0.0, 0.0225, 0.0001));
+  filter.initialize(testing::planarPose(now, 0.0, 0.0, yaw, 0.0225, 0.0001));
   std::mt19937 rng(11);
   const double variance = 0.02 * 0.02;
   std::normal_distribution<double> noise(0.0, std::sqrt(variance));
@@ -137,10 +139,13 @@ SourceCounters nisOfFixes(double stated_over_true) {
       filter.feedTwist(odom, testing::twist(now, 0.0, 0.0, 1e-6, 1e-6));
       filter.advanceTo(now);
     }
-    filter.feedPose(rsu, testing::fix2d(now, noise(rng), noise(rng), variance * stated_over_true));
+    const double x = noise(rng), y = y_over_x * noise(rng);
+    filter.feedPose(rsu, testing::fix2d(now, x, y, variance * stated_over_true));
   }
-  return filter.counters(rsu);
+  return {filter.counters(rsu), filter.counters(odom)};
 }
+
+SourceCounters nisOfFixes(double stated_over_true) { return countersOfFixes(stated_over_true).first; }
 
 TEST(Consistency, HonestCovariancesGiveANormalizedInnovationOfOnePerDegreeOfFreedom) {
   const SourceCounters c = nisOfFixes(1.0);
@@ -165,6 +170,27 @@ TEST(Consistency, AnOverconfidentSourceShowsAboveTheBandAndAConservativeOneBelow
   const SourceCounters under = nisOfFixes(10.0);
   EXPECT_LT(under.nis_sum / static_cast<double>(under.nis_dof), 0.2);
   EXPECT_GT(under.nis_below / static_cast<double>(under.nis_samples), 0.2);
+}
+
+TEST(Consistency, EachComponentShowsItsOwnHonestyAlongAndAcrossTheVehicle) {
+  // The vehicle heads north (yaw 90 deg): along it is the map's y. Fixes drawn with the spread stated
+  // across (map x) and a tenth of the spread stated along (map y).
+  const auto [c, t] = countersOfFixes(1.0, M_PI / 2.0, 0.1);
+  ASSERT_EQ(c.nis_component_samples[kNisAlong], 2000u);
+  ASSERT_EQ(c.nis_component_samples[kNisAcross], 2000u);
+  EXPECT_EQ(c.nis_component_samples[kNisYaw], 0u);  // a 2-D fix measures no yaw
+  const double along = c.nis_component_sum[kNisAlong] / 2000.0, across = c.nis_component_sum[kNisAcross] / 2000.0;
+  // Across: honest, a little under 1 as in the test above (the filter's own variance). Along: the
+  // innovation's variance is a hundredth of the fix's stated one plus the filter's, well below 0.1.
+  EXPECT_GT(across, 0.8);
+  EXPECT_LT(across, 1.1);
+  EXPECT_LT(along, 0.1);
+  // The whole figure mixes them: near half.
+  EXPECT_NEAR(c.nis_sum / static_cast<double>(c.nis_dof), 0.5 * (along + across), 0.05);
+  // A twist's components are its speed and yaw rate.
+  EXPECT_GT(t.nis_component_samples[kNisSpeed], 0u);
+  EXPECT_EQ(t.nis_component_samples[kNisSpeed], t.nis_component_samples[kNisYawRate]);
+  EXPECT_EQ(t.nis_component_samples[kNisAlong], 0u);
 }
 
 TEST(Consistency, TheBandOfTheMeanNarrowsWithTheDegreesOfFreedomAsTheChiSquare) {

@@ -125,7 +125,9 @@ TEST(MapMatchBias, ALateFixGivesTheSameBiasAndPoseAsOnTime) {
       if (k % 5 == 0) f->feedPose("ndt", planarPose(t, x + 0.1, 0.0, 0.0, 1e-4, 1e-6));
     }
     if (k == 20) on_time.feedPose("rsu", fix2d(t, x, 0.0, 2e-4));
-    if (k == 27) EXPECT_TRUE(late.feedPose("rsu", fix2d(kStart + 20 * kTick, kSpeed * 20 * toSeconds(kTick), 0.0, 2e-4)).applied());
+    if (k == 27) {
+      EXPECT_TRUE(late.feedPose("rsu", fix2d(kStart + 20 * kTick, kSpeed * 20 * toSeconds(kTick), 0.0, 2e-4)).applied());
+    }
   }
   const Estimate a = *on_time.estimate(), b = *late.estimate();
   EXPECT_NEAR((a.pose.position - b.pose.position).norm(), 0.0, 1e-9);

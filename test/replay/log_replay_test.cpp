@@ -371,8 +371,11 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
   // they would be floored at the map's noise, 0 here); reported on their own, they always are.
   const ReplayResult held = replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "poor.yaml") + "\nfusion:\n  map_match_bias_sd: 0.1\n");
   EXPECT_EQ(held.pipeline_report.ndt_quality_raised, 3u);
-  for (const auto& [key, covariance] : held.claimedCovariances())
-    if (key.first == pipeline::kNdtSource) EXPECT_GE(covariance.trace(), 0.5 * (1.0 - 1e-9));
+  for (const auto& [key, covariance] : held.claimedCovariances()) {
+    if (key.first == pipeline::kNdtSource) {
+      EXPECT_GE(covariance.trace(), 0.5 * (1.0 - 1e-9));
+    }
+  }
   for (const auto& [key, covariance] : plain.claimedCovariances()) {
     if (key.first != pipeline::kNdtSource) continue;
     EXPECT_LT(covariance.trace(), 0.1) << "the fit's own covariance, as before";

@@ -74,4 +74,10 @@ nis=$(grep -A4 "NDT's normalized innovation squared" "$work/out/README.md" | gre
   { echo "FAIL: no row of NDT's normalized innovation squared for the site"; exit 1; }
 echo "$nis" | grep -qE '^\| small_site( \| [0-9]+\.[0-9]+ \((0\.[0-9]+)-(1\.[0-9]+)\))+ \|$' ||
   { echo "FAIL: the NIS row '$nis' is not each configuration's figure and band"; exit 1; }
-echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected; NDT's NIS: $nis"
+# And per component, along / across / yaw, for each configuration.
+parts=$(grep -A5 "The same per component" "$work/out/README.md" | grep '^| small_site |') ||
+  { echo "FAIL: no row of NDT's normalized innovation squared per component for the site"; exit 1; }
+num='[0-9][0-9.e+-]*'
+echo "$parts" | grep -qE "^\| small_site( \| $num / $num / $num)+ \|\$" ||
+  { echo "FAIL: the per-component NIS row '$parts' is not along / across / yaw for each configuration"; exit 1; }
+echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected; NDT's NIS: $nis; per component: $parts"

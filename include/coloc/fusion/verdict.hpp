@@ -1,5 +1,6 @@
 #pragma once
 // What became of one input: applied, waiting for the filter's clock, or rejected for a named reason.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -71,7 +72,17 @@ struct SourceCounters {
   double nis_sum = 0.0;           ///< their d^2 summed: nis_sum / nis_dof is 1 when honest
   std::uint64_t nis_above = 0;    ///< samples above their chi-square's 97.5 % quantile (2.5 % if honest)
   std::uint64_t nis_below = 0;    ///< samples below its 2.5 % quantile (2.5 % if honest)
+  /// The same for each component alone, e_i^2 / S_ii (chi-square(1) when honest), summed over the
+  /// samples that measured it (NisComponent): a whole figure near 1 can hide one component trusted
+  /// too little and another too much, and a corridor's direction is along the road, not along x.
+  std::array<double, 5> nis_component_sum{};
+  std::array<std::uint64_t, 5> nis_component_samples{};
 };
+
+/// The components of SourceCounters::nis_component_sum: a pose's position along and across the
+/// filter's yaw at its first use, and its yaw; a twist's speed and yaw rate.
+enum NisComponent : int { kNisAlong = 0, kNisAcross = 1, kNisYaw = 2, kNisSpeed = 3, kNisYawRate = 4 };
+const char* toString(NisComponent component);
 
 /// The band the mean NIS per degree of freedom (nis_sum / nis_dof) lies in 95 % of the time when the
 /// covariances are honest: the chi-square(dof) quantiles over dof (Wilson-Hilferty), {lower, upper}.

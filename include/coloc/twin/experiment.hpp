@@ -5,6 +5,7 @@
 // pose as NDT's initial guess as on a vehicle. The configurations of a trial share the drive and the
 // scans, so their comparison is paired.
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <map>
 #include <string>
@@ -37,6 +38,10 @@ struct ExperimentRun {
   /// freedom (fusion::SourceCounters::nis_sum, nis_dof; the ratio is 1 when the covariances are honest).
   double ndt_nis_sum = 0.0;
   std::uint64_t ndt_nis_dof = 0;
+  /// The same per component, along and across the vehicle and yaw (fusion::kNisAlong, kNisAcross,
+  /// kNisYaw): e_i^2 / S_ii summed, and the poses that measured it.
+  std::array<double, 3> ndt_nis_component_sum{};
+  std::array<std::uint64_t, 3> ndt_nis_component_samples{};
 
   std::string label() const;  ///< "NDT only", "NDT + VLP-16", "NDT + VLP-16, 30 ms, 20 % loss"
 };
