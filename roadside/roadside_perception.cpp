@@ -1,25 +1,24 @@
 #include "coloc/roadside/roadside_perception.hpp"
 
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_types.h>
-
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
+#include <string>
 #include <unordered_map>
 
 #include "coloc/core/error.hpp"
 #include "coloc/roadside/road_surface.hpp"
+#include "near_points.hpp"
 
 namespace coloc::roadside {
 
 struct RoadsidePerception::Impl {
   RoadsidePerceptionConfig config;
   RsuMount mount;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr background;
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  std::optional<NearPoints> background;  ///< the reference frame's points, sensor frame
   Eigen::Matrix3d rotation;  ///< sensor axes to map axes (yaw, pitch, roll)
   RoadSurface road;          ///< the local road's height, map frame
 };
@@ -68,11 +67,11 @@ RoadsidePerception::RoadsidePerception(const std::vector<Eigen::Vector3f>& refer
                                        const RoadsidePerceptionConfig& config)
     : impl_(std::make_unique<Impl>()) {
   if (reference_frame.empty()) throw Error("roadside perception: the reference (background) frame is empty");
+  if (!(std::isfinite(config.background_distance) && config.background_distance > 0.0))
+    throw Error("roadside perception: background_distance must be finite and > 0 m, got " + std::to_string(config.background_distance));
   impl_->config = config;
   impl_->mount = mount;
-  impl_->background = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  for (const auto& p : reference_frame) impl_->background->push_back({p.x(), p.y(), p.z()});
-  impl_->tree.setInputCloud(impl_->background);
+  impl_->background.emplace(reference_frame, config.background_distance);
   impl_->rotation = (Eigen::AngleAxisd(mount.yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(mount.pitch, Eigen::Vector3d::UnitY()) *
                      Eigen::AngleAxisd(mount.roll, Eigen::Vector3d::UnitX()))
                         .toRotationMatrix();
@@ -231,9 +230,6 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   // bearings they fall in.
   int background_occluders = 0;
   std::vector<bool> hidden(20, false);
-  std::vector<int> index(1);
-  std::vector<float> distance_sq(1);
-  const double background_sq = c.background_distance * c.background_distance;
   for (const Eigen::Vector3f& p : frame) {
     const Eigen::Vector3d in_map = impl_->rotation * p.cast<double>() + impl_->mount.position;
     const Eigen::Vector2d xy = in_map.head<2>();
@@ -241,7 +237,7 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
     if (!near && !(c.attribute && inSector(xy, in_map.z()))) continue;
     const double height = in_map.z() - road.height(xy);
     if (height < 0.05) continue;  // the road itself
-    if (impl_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, distance_sq) > 0 && distance_sq[0] <= background_sq) {
+    if (impl_->background->anyWithin(p)) {
       // What stands still between the LiDAR and the vehicle (a parked car, a hedge) hides part of it as
       // much as what moves: background to the clustering, an occluder all the same, by the share of the
       // footprint's bearings it covers (a post or a sign's pole in front of a car hides a strip of it).
