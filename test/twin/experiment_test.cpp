@@ -24,7 +24,7 @@ std::string errorOf(const std::string& yaml) {
 
 TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   const ExperimentConfig c = parseExperimentConfig("", "exp.yaml");
-  EXPECT_EQ(c.sites, (std::vector<std::string>{"site_a", "site_b", "site_c", "site_d"}));
+  EXPECT_EQ(c.sites, (std::vector<std::string>{"site_a", "site_b", "site_c", "site_d", "site_e"}));
   EXPECT_EQ(c.trials, 10);
   EXPECT_EQ(c.lidars, (std::vector<std::string>{"VLP-16", "VLP-32C"}));
   EXPECT_EQ(c.delays, (std::vector<double>{0.0, 0.010, 0.030}));
@@ -95,7 +95,7 @@ TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideI
 }
 
 TEST(ExperimentConfig, BuiltInScenariosAreTheShippedFiles) {
-  for (const char* name : {"site_a", "site_b", "site_c", "site_d"}) {
+  for (const char* name : {"site_a", "site_b", "site_c", "site_d", "site_e"}) {
     std::ifstream in(std::string(COLOC_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
     std::ostringstream text;
     text << in.rdbuf();
