@@ -16,7 +16,7 @@ using namespace coloc::twin;
 void addExperimentCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("experiment",
                                  "The paper's experiment on the digital twin: NDT only against NDT + roadside fusion with a VLP-16 and a "
-                                 "VLP-32C, at the built-in sites (A, B, C) or your own, over trials and a network grid; tables and figures");
+                                 "VLP-32C, at the built-in sites (A-E: where NDT is good, and where it falls short by geometry and by the map's age) or your own, over trials and a network grid; tables and figures");
   static std::string file, out_dir = "results/experiment";
   static int trials = 0, jobs = 0;
   static bool quick = false, sweeps = false, no_network = false, recordings = false;
