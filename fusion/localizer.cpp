@@ -211,7 +211,7 @@ struct Localizer::Impl {
       c.nis_sum += d2;
       c.nis_above += d2 > nis_band[record.m].second ? 1 : 0;
       c.nis_below += d2 < nis_band[record.m].first ? 1 : 0;
-      const std::array<double, 5> parts = componentNis(history.stateAt(back), record);
+      const std::array<double, kNisComponents> parts = componentNis(history.stateAt(back), record);
       for (std::size_t k = 0; k < parts.size(); ++k) {
         if (!std::isfinite(parts[k])) continue;
         c.nis_component_sum[k] += parts[k];

@@ -140,8 +140,8 @@ Innovation innovation(const FilterState& state, const UpdateRecord& record, doub
   return innovationWith(state, record, model(state, record), scale);
 }
 
-std::array<double, 5> componentNis(const FilterState& state, const UpdateRecord& record) {
-  std::array<double, 5> out;
+std::array<double, kNisComponents> componentNis(const FilterState& state, const UpdateRecord& record) {
+  std::array<double, kNisComponents> out;
   out.fill(std::numeric_limits<double>::quiet_NaN());
   if (record.m == 0) return out;
   const Innovation in = innovation(state, record, 1.0);

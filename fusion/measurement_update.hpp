@@ -37,7 +37,7 @@ Innovation innovation(const FilterState& state, const UpdateRecord& record, doub
 
 /// Each measured component's e_i^2 / S_ii alone (NisComponent order; NaN where not measured or S_ii
 /// is not positive), x and y turned to along and across the state's yaw where both are measured.
-std::array<double, 5> componentNis(const FilterState& state, const UpdateRecord& record);
+std::array<double, kNisComponents> componentNis(const FilterState& state, const UpdateRecord& record);
 
 /// e^T S^-1 e with the measurement's own covariance; +inf if S is not positive definite.
 double mahalanobisSquared(const FilterState& state, const UpdateRecord& record);

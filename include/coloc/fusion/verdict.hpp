@@ -1,6 +1,7 @@
 #pragma once
 // What became of one input: applied, waiting for the filter's clock, or rejected for a named reason.
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -48,6 +49,12 @@ struct Verdict {
   std::string message() const;
 };
 
+/// The components of SourceCounters::nis_component_sum: a pose's position along and across the
+/// filter's yaw at its first use, and its yaw; a twist's speed and yaw rate.
+enum NisComponent : int { kNisAlong = 0, kNisAcross = 1, kNisYaw = 2, kNisSpeed = 3, kNisYawRate = 4 };
+inline constexpr std::size_t kNisComponents = 5;
+const char* toString(NisComponent component);
+
 /// Per-source tallies; every input lands in exactly one of the final counters or in `pending`.
 struct SourceCounters {
   std::uint64_t received = 0;
@@ -75,14 +82,9 @@ struct SourceCounters {
   /// The same for each component alone, e_i^2 / S_ii (chi-square(1) when honest), summed over the
   /// samples that measured it (NisComponent): a whole figure near 1 can hide one component trusted
   /// too little and another too much, and a corridor's direction is along the road, not along x.
-  std::array<double, 5> nis_component_sum{};
-  std::array<std::uint64_t, 5> nis_component_samples{};
+  std::array<double, kNisComponents> nis_component_sum{};
+  std::array<std::uint64_t, kNisComponents> nis_component_samples{};
 };
-
-/// The components of SourceCounters::nis_component_sum: a pose's position along and across the
-/// filter's yaw at its first use, and its yaw; a twist's speed and yaw rate.
-enum NisComponent : int { kNisAlong = 0, kNisAcross = 1, kNisYaw = 2, kNisSpeed = 3, kNisYawRate = 4 };
-const char* toString(NisComponent component);
 
 /// The band the mean NIS per degree of freedom (nis_sum / nis_dof) lies in 95 % of the time when the
 /// covariances are honest: the chi-square(dof) quantiles over dof (Wilson-Hilferty), {lower, upper}.
