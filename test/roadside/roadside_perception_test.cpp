@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
+#include <string>
 
 #include "coloc/core/error.hpp"
 #include "coloc/sim/error_sources.hpp"
@@ -145,6 +147,19 @@ TEST(RoadsidePerception, ACarPassingBelowAMastsLowestBeamIsRefusedForWantOfRetur
 }
 
 TEST(RoadsidePerception, EmptyReferenceFrameIsAnError) { EXPECT_THROW(RoadsidePerception({}, RsuMount{}), Error); }
+
+TEST(RoadsidePerception, ABackgroundDistanceThatIsNotAPositiveNumberIsRefusedByName) {
+  for (double bad : {0.0, -0.15, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    RoadsidePerceptionConfig config;
+    config.background_distance = bad;
+    try {
+      RoadsidePerception refused({Eigen::Vector3f(10.0f, 0.0f, 0.0f)}, RsuMount{}, config);
+      ADD_FAILURE() << "a background distance of " << bad << " was taken";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("background_distance must be finite and > 0"), std::string::npos) << e.what();
+    }
+  }
+}
 
 TEST(RoadsidePerception, NoVehicleInViewIsNotFound) {
   RayCaster world;
