@@ -203,7 +203,8 @@ struct Localizer::Impl {
     // A pose taken between ticks is compared with the tick's state carried to its stamp; the offset is
     // fixed in the record, so every use and replay linearizes the same model at its own state.
     if (src.kind == SourceKind::kPose && config.pose_time_alignment) record.time_offset = toSeconds(stamp - history.stampAt(back));
-    const double d2 = mahalanobisSquared(history.stateAt(back), record);
+    const NormalizedInnovation normalized = normalizedInnovation(history.stateAt(back), record);
+    const double d2 = normalized.d2;
     if (record.m > 0 && std::isfinite(d2)) {
       SourceCounters& c = src.counters;
       ++c.nis_samples;
@@ -211,7 +212,7 @@ struct Localizer::Impl {
       c.nis_sum += d2;
       c.nis_above += d2 > nis_band[record.m].second ? 1 : 0;
       c.nis_below += d2 < nis_band[record.m].first ? 1 : 0;
-      const std::array<double, kNisComponents> parts = componentNis(history.stateAt(back), record);
+      const std::array<double, kNisComponents>& parts = normalized.components;
       for (std::size_t k = 0; k < parts.size(); ++k) {
         if (!std::isfinite(parts[k])) continue;
         c.nis_component_sum[k] += parts[k];

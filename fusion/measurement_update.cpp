@@ -140,11 +140,12 @@ Innovation innovation(const FilterState& state, const UpdateRecord& record, doub
   return innovationWith(state, record, model(state, record), scale);
 }
 
-std::array<double, kNisComponents> componentNis(const FilterState& state, const UpdateRecord& record) {
+namespace {
+
+// Each measured component's e_i^2 / S_ii alone, x and y turned to along and across the state's yaw.
+std::array<double, kNisComponents> componentsOf(const FilterState& state, const UpdateRecord& record, const Innovation& in) {
   std::array<double, kNisComponents> out;
   out.fill(std::numeric_limits<double>::quiet_NaN());
-  if (record.m == 0) return out;
-  const Innovation in = innovation(state, record, 1.0);
   const auto ratio = [](double e, double s) { return s > 0.0 ? e * e / s : std::numeric_limits<double>::quiet_NaN(); };
   int row_x = -1, row_y = -1;
   for (int i = 0; i < in.m; ++i) {
@@ -171,15 +172,22 @@ std::array<double, kNisComponents> componentNis(const FilterState& state, const 
   return out;
 }
 
-double mahalanobisSquared(const FilterState& state, const UpdateRecord& record) {
-  if (record.m == 0) return 0.0;
+}  // namespace
+
+NormalizedInnovation normalizedInnovation(const FilterState& state, const UpdateRecord& record) {
+  NormalizedInnovation out;
+  out.components.fill(std::numeric_limits<double>::quiet_NaN());
+  if (record.m == 0) return out;
   const Innovation in = innovation(state, record, 1.0);
+  out.components = componentsOf(state, record, in);
   Eigen::Matrix<double, 3, 1> solved = Eigen::Matrix<double, 3, 1>::Zero();
-  if (!solveSpd<1>(in.S, in.m, in.e, solved)) return kInfinity;
+  if (!solveSpd<1>(in.S, in.m, in.e, solved)) {
+    out.d2 = kInfinity;
+    return out;
+  }
   // A plain loop over the measured rows: GCC's array-bounds analysis misreads head(m).dot() on fixed 3-vectors.
-  double d2 = 0.0;
-  for (int i = 0; i < in.m; ++i) d2 += in.e[i] * solved[i];
-  return d2;
+  for (int i = 0; i < in.m; ++i) out.d2 += in.e[i] * solved[i];
+  return out;
 }
 
 bool applyUpdate(FilterState& state, const UpdateRecord& record) {

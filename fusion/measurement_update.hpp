@@ -35,12 +35,15 @@ struct Innovation {
 };
 Innovation innovation(const FilterState& state, const UpdateRecord& record, double scale);
 
-/// Each measured component's e_i^2 / S_ii alone (NisComponent order; NaN where not measured or S_ii
-/// is not positive), x and y turned to along and across the state's yaw where both are measured.
-std::array<double, kNisComponents> componentNis(const FilterState& state, const UpdateRecord& record);
-
-/// e^T S^-1 e with the measurement's own covariance; +inf if S is not positive definite.
-double mahalanobisSquared(const FilterState& state, const UpdateRecord& record);
+/// The innovation against the measurement's own covariance, from one innovation: the whole
+/// d^2 = e^T S^-1 e (0 with nothing measured, +inf if S is not positive definite), and each measured
+/// component's e_i^2 / S_ii alone (NisComponent order; NaN where not measured or S_ii is not
+/// positive), x and y turned to along and across the state's yaw where both are measured.
+struct NormalizedInnovation {
+  double d2 = 0.0;
+  std::array<double, kNisComponents> components{};
+};
+NormalizedInnovation normalizedInnovation(const FilterState& state, const UpdateRecord& record);
 
 /// Applies the record with covariance x record.scale. Returns false (state untouched) only if the
 /// innovation covariance is not positive definite, which validated input cannot produce.

@@ -529,8 +529,8 @@ struct Pipeline::Impl {
     // error, as without the bias (site C's NDT alone, in coverage: 2.7 cm with the bias loose, 1.4 cm).
     const double place = ndt_quality.varianceAt(pose.pose.position.head<2>());
     double floor = place;
+    const std::optional<fusion::Estimate> now = localizer.estimate();
     if (config.fusion.map_match_bias_sd > 0.0) {
-      const std::optional<fusion::Estimate> now = localizer.estimate();
       const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
       const bool told_apart = last_anchor && pose.stamp - *last_anchor <= fromSeconds(hold);
       double spread = 0.0;
@@ -553,10 +553,9 @@ struct Pipeline::Impl {
     // A pose with nothing to compare yet is taken at no better than the unverified figure.
     // The odometry's travel is laid along the direction of motion: NDT's yaw plus the filter's yaw bias
     // (a LiDAR turned 0.6 deg from its calibration puts a 4 m chord 4 cm aside of NDT's own heading).
-    const std::optional<fusion::Estimate> motion = localizer.estimate();
     const double yaw = rollPitchYaw(pose.pose.orientation)[2];
     const std::optional<Eigen::Vector2d> excess =
-        travel_check.check(pose.stamp, pose.pose.position.head<2>(), yaw + (motion ? motion->yaw_bias : 0.0));
+        travel_check.check(pose.stamp, pose.pose.position.head<2>(), yaw + (now ? now->yaw_bias : 0.0));
     if (!excess) {
       for (PoseMeasurement* p : {&pose, &alone})
         p->covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(p->covariance.topLeftCorner<2, 2>(),

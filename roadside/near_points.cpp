@@ -50,9 +50,9 @@ NearPoints::NearPoints(const std::vector<Eigen::Vector3f>& points, double distan
   std::stable_sort(binned.begin(), binned.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   m.points.reserve(binned.size());
   for (std::size_t i = 0; i < binned.size(); ++i) {
-    if (i == 0 || binned[i].first != binned[i - 1].first) m.cells[binned[i].first] = {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i)};
+    const auto index = static_cast<std::uint32_t>(i);
+    ++m.cells.try_emplace(binned[i].first, index, index).first->second.second;
     m.points.push_back(binned[i].second);
-    ++m.cells[binned[i].first].second;
   }
 }
 
