@@ -26,6 +26,7 @@ fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
 
-# The main job on built-in defaults: the paper's experiment on the digital twin, one trial of each
-# configuration (`coloc experiment` without --quick runs the full ten trials).
+# The main job on built-in defaults: the paper's experiment on the digital twin in quick mode, a first
+# look (Table I on every site, one trial; `coloc experiment` without --quick runs the full ten trials,
+# the whole network grid and the RSU calibration study).
 build/tools/coloc experiment --quick --out results/experiment

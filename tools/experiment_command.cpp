@@ -24,14 +24,14 @@ void addExperimentCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", out_dir, "results folder")->capture_default_str();
   cmd->add_option("--trials", trials, "trials per site (default 10)")->check(wholeNumber(1, 1000));
-  cmd->add_flag("--quick", quick, "one trial of everything: a first look in under a minute on two cores");
+  cmd->add_flag("--quick", quick, "a first look: Table I on every site, one trial, the network grid's corners (0 / 30 ms, 0 / 20 %), no RSU calibration study; a FILE's keys override these");
   cmd->add_flag("--sweeps", sweeps, "also sweep the RSU covariance, the RSU height and the speed");
   cmd->add_flag("--no-network", no_network, "skip the network grid (Tables II and III)");
   cmd->add_flag("--recordings", recordings, "keep each drive's rosbag2 log under OUT/recordings/ (a few hundred MB per drive)");
   cmd->add_option("--jobs", jobs, "replays run side by side (default 2)")->check(wholeNumber(1, 64));
   cmd->callback([app = &app] {
-    ExperimentConfig config = file.empty() ? ExperimentConfig{} : loadExperimentConfig(file);
-    if (quick) config = quickExperiment(config);
+    const ExperimentConfig defaults = quick ? quickExperiment() : ExperimentConfig{};
+    ExperimentConfig config = file.empty() ? defaults : loadExperimentConfig(file, defaults);
     if (trials > 0) config.trials = trials;
     if (jobs > 0) config.jobs = jobs;
     if (sweeps) config.sweeps = true;

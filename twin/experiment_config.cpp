@@ -28,17 +28,21 @@ RsuCovariance referenceCovariance(RsuCovariance main) {
   return main == RsuCovariance::kPublished ? RsuCovariance::kEstimated : RsuCovariance::kPublished;
 }
 
-ExperimentConfig quickExperiment(ExperimentConfig config) {
+ExperimentConfig quickExperiment() {
+  ExperimentConfig config;
   config.trials = 1;
   config.sweep_trials = 1;
   config.network_trials = 1;
+  config.delays = {0.0, 0.030};
+  config.losses = {0.0, 0.20};
+  config.calibration = false;
   return config;
 }
 
-ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::string& source_name) {
+ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::string& source_name, const ExperimentConfig& defaults) {
   const YamlReader r(source_name);
   const YAML::Node root = r.parse(yaml_text);
-  ExperimentConfig c;
+  ExperimentConfig c = defaults;
   if (root.IsNull()) return c;
   if (!root.IsMap()) r.fail(root, "(file)", "expected a mapping of keys to values");
   for (const auto& entry : root) {
@@ -103,8 +107,8 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
   return c;
 }
 
-ExperimentConfig loadExperimentConfig(const std::string& path) {
-  ExperimentConfig c = parseExperimentConfig(YamlReader::readFile(path, "experiment file"), path);
+ExperimentConfig loadExperimentConfig(const std::string& path, const ExperimentConfig& defaults) {
+  ExperimentConfig c = parseExperimentConfig(YamlReader::readFile(path, "experiment file"), path, defaults);
   // Files the experiment names are found beside it, as a configuration's registry is.
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   if (!c.fuse_config.empty() && std::filesystem::path(c.fuse_config).is_relative()) c.fuse_config = (folder / c.fuse_config).string();

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -141,6 +142,11 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   const ExperimentConfig& c = results.config;
   const double bin = c.bin_length;
   std::ostringstream md;
+  // The tables a run may write. An earlier run's into the same folder go first: a quick run after a full
+  // one leaves no calibration or sweep table of the full run's beside its own.
+  static const char* const kTables[] = {"table1.csv", "smoother.csv", "calibration.csv", "network.csv", "sweeps.csv",
+                                        "fix_error_by_distance.csv", "attribution.csv", "ndt_vs_fused.csv"};
+  for (const char* t : kTables) std::filesystem::remove(out_dir + "/" + t);
 
   // runs.csv: every replay's error within each LiDAR's coverage.
   {
@@ -812,8 +818,11 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << " sweeps and frames reused from an earlier drive of the site; " << fmt("the LiDARs' noise and dropouts %.1f s, ", tm.lidar)
      << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
      << "(" << c.jobs << " side by side).\n\n"
-     << "## Files\n\n"
-     << "- `table1.csv`, `smoother.csv`, `calibration.csv`, `network.csv`, `sweeps.csv`, `fix_error_by_distance.csv`, `attribution.csv`, `ndt_vs_fused.csv`: the tables; `runs.csv`: every replay's error within each coverage range\n"
+     << "## Files\n\n- ";
+  const char* separator = "";
+  for (const char* t : kTables)
+    if (std::filesystem::exists(out_dir + "/" + t)) md << separator << "`" << t << "`", separator = ", ";
+  md << ": the tables; `runs.csv`: every replay's error within each coverage range\n"
      << "- `error_along_road.csv`: minimum error per bin along the road, per site, trial and configuration (figures 4 and 5)\n"
      << "- `recordings/SITE/trial_N/`: each drive's map and fuse configuration, the RSU fixes, every RSU frame's outcome "
         "(`rsu_frames.csv`) and, for trial 0, what each perception step buys (`rsu_perception.svg`)"

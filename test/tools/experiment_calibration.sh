@@ -14,7 +14,13 @@ dir=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$dir"
+# An earlier run's network table in the folder: this run has no network grid, and its folder and
+# report must not show one.
+mkdir -p "$work/out" && echo "stale" > "$work/out/network.csv"
 "$coloc" experiment --quick experiment_calibration.yaml --out "$work/out" > "$work/run.txt"
+[ ! -e "$work/out/network.csv" ] || { echo "FAIL: an earlier run's network.csv left beside this run's tables"; exit 1; }
+grep -q '^- `table1.csv`, .*`calibration.csv`.*: the tables;' "$work/out/README.md" || { echo "FAIL: the report's file list is not the tables written"; exit 1; }
+! grep -q 'network.csv' "$work/out/README.md" || { echo "FAIL: the report lists a network table it did not write"; exit 1; }
 # calibration.csv: site,lidar,rsu,injected_dx_m,injected_dy_m,injected_dyaw_deg,injected_clock_ms,dx_m,dy_m,dyaw_deg,clock_ms,...,
 #                  observable,clock_observable,next_as_surveyed_m,next_calibrated_m,next_perfect_m
 awk -F, 'NR > 1 {

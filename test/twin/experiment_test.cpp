@@ -40,7 +40,29 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_EQ(c.oracle_fix_limit, 0.0);  // the analysis bound is off
   EXPECT_TRUE(c.rsu_background_learned);  // as an RSU on site learns it, from the busy street
   EXPECT_EQ(c.network_trials, 10);  // the grid on every trial: one trial's change spreads by 5-18 points
-  EXPECT_EQ(quickExperiment(c).trials, 1);
+}
+
+TEST(ExperimentConfig, TheQuickRunIsAFirstLookWhoseDefaultsAFilesKeysOverride) {
+  const ExperimentConfig full, quick = quickExperiment();
+  EXPECT_EQ(quick.trials, 1);
+  EXPECT_EQ(quick.sweep_trials, 1);
+  EXPECT_EQ(quick.network_trials, 1);
+  EXPECT_EQ(quick.delays, (std::vector<double>{0.0, 0.030}));  // the grid's corners: the paper's headline cell
+  EXPECT_EQ(quick.losses, (std::vector<double>{0.0, 0.20}));
+  EXPECT_FALSE(quick.calibration);  // the RSU calibration study is the full run's
+  EXPECT_EQ(quick.sites, full.sites);  // Table I on every site, as the full run
+  EXPECT_EQ(quick.lidars, full.lidars);
+  EXPECT_EQ(quick.smoother, full.smoother);
+  // A file's keys override the quick run's defaults, and only those keys.
+  const ExperimentConfig c = parseExperimentConfig("calibration: true\ntrials: 2\n", "exp.yaml", quick);
+  EXPECT_TRUE(c.calibration);
+  EXPECT_EQ(c.trials, 2);
+  EXPECT_EQ(c.delays, quick.delays);
+  EXPECT_EQ(c.network_trials, 1);
+  EXPECT_EQ(parseExperimentConfig("", "exp.yaml", quick).delays, quick.delays);  // an empty file changes nothing
+  // Without them given, a file overrides the full run's.
+  EXPECT_TRUE(parseExperimentConfig("trials: 2\n", "exp.yaml").calibration);
+  EXPECT_EQ(parseExperimentConfig("trials: 2\n", "exp.yaml").delays, full.delays);
 }
 
 TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
