@@ -147,6 +147,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   static const char* const kTables[] = {"table1.csv", "smoother.csv", "calibration.csv", "network.csv", "sweeps.csv",
                                         "fix_error_by_distance.csv", "attribution.csv", "ndt_vs_fused.csv"};
   for (const char* t : kTables) std::filesystem::remove(out_dir + "/" + t);
+  std::filesystem::remove(out_dir + "/network.svg");  // the network table's figure
 
   // runs.csv: every replay's error within each LiDAR's coverage.
   {
