@@ -138,6 +138,19 @@ AlignedBox fitBody(const std::vector<std::size_t>& points, const std::vector<Eig
   return alignTrueSizeBox(rectangle, xy, lidar, length, width, heading_prior);
 }
 
+// How much shorter than its side of the vehicle the one face seen may be (AlignedBox::face_shortfall).
+// A front or rear face seen obliquely rests the box on its near end, the body's corner. Its returns stop
+// inside the body's edges by up to a column's spacing on the face at each end, one spacing in all on
+// average: 0.3-0.4 m at 50-60 m from a 64-beam LiDAR (0.35 deg), as much as a label's excess width. So it
+// may be short by max_width_face_shortfall plus that spacing. Placed from its near end with the CAM's
+// width, its error across is half the shortfall plus half the near end's loss less the far end's: at
+// most (shortfall + spacing) / 2, which max_face_placement_error bounds.
+double faceShortfallLimit(const AlignedBox& box, double range, const RoadsidePerceptionConfig& c) {
+  if (!box.width_face_alone || box.face_obliquity < c.oblique_face) return c.max_face_shortfall;
+  const double spacing = range * c.covariance.azimuth_step / std::max(std::cos(box.face_obliquity), 0.5);
+  return std::min(c.max_width_face_shortfall + spacing, 2.0 * c.max_face_placement_error - spacing);
+}
+
 // Whether a face's far end, `end`, is seen as its end (BodySizeConfig::end_clearance): the LiDAR's
 // next columns beyond it, away from `corner`, at elevations lo..hi (rad, those the body was seen at),
 // return from farther than the end by `clearance`, and none from nearer. `rotation` turns a frame's
@@ -364,8 +377,15 @@ VehicleDetection RoadsidePerception::detect(const std::vector<Eigen::Vector3f>& 
   out.fit_points = xy.size();
   out.corner_seen = box.corner_seen;
   out.face_shortfall = box.face_shortfall;
-  if (c.attribute && c.align_true_size && box.face_shortfall > (box.width_face_alone && box.face_obliquity >= c.oblique_face ? c.max_width_face_shortfall : c.max_face_shortfall))
+  if (c.attribute && c.align_true_size && box.face_shortfall > faceShortfallLimit(box, (box.alignment_point - lidar).norm(), c))
     return finish(Refusal::kCornerNotSeen);
+  // One face seen: the box rests on it as on the body's end, which no return of the vehicle, at any
+  // height, lies beyond.
+  if (c.attribute && c.align_true_size && !box.corner_seen && c.max_face_overhang > 0.0) {
+    const Eigen::Vector2d outward = box.width_face_alone ? Eigen::Vector2d(-box.along) : Eigen::Vector2d(-box.across);
+    for (std::size_t i : vehicle_points) out.face_overhang = std::max(out.face_overhang, (foreground[i].head<2>() - box.alignment_point).dot(outward));
+    if (out.face_overhang > c.max_face_overhang) return finish(Refusal::kCornerNotSeen);
+  }
   // The fit's heading against the CAM's (modulo a half turn: the L-shape cannot tell front from back).
   if (c.attribute && c.max_heading_disagreement > 0.0) {
     const double off = std::abs(wrapAngle(2.0 * (box.yaw - heading_prior))) / 2.0;
