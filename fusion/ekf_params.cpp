@@ -22,6 +22,7 @@ const std::vector<EkfParam>& ekfParams() {
       {"twist_gate_alpha", "", "as pose_gate_alpha, for twists", &C::twist_gate_alpha},
       {"pose_time_alignment", "", "carry a pose from its stamp to the tick it is applied at (up to half a tick) with the state's speed and yaw rate; off = Autoware's rounding", &C::pose_time_alignment},
       {"pose_gate_recovery", "poses", "after this many gated poses of a source in a row, the next are applied at the gate's weight until one passes; 0 = off", &C::pose_gate_recovery},
+      {"twist_gate_recovery", "twists", "as pose_gate_recovery, for twists (a yaw rate that steps beyond a tight gate); 0 = off", &C::twist_gate_recovery},
       {"z_filter_proc_dev", "m/s", "random walk of the separate z filter", &C::z_filter_proc_dev},
       {"roll_filter_proc_dev", "rad/s", "random walk of the separate roll filter", &C::roll_filter_proc_dev},
       {"pitch_filter_proc_dev", "rad/s", "random walk of the separate pitch filter", &C::pitch_filter_proc_dev},

@@ -32,6 +32,7 @@ void validate(const EkfConfig& c) {
   requireConfig(c.max_twist_queue_size >= 1, "max_twist_queue_size", "must be >= 1");
   requireConfig(c.pose_gate_alpha >= 0.0 && c.pose_gate_alpha < 1.0, "pose_gate_alpha", "must be in [0, 1)");
   requireConfig(c.pose_gate_recovery >= 0, "pose_gate_recovery", "must be >= 0");
+  requireConfig(c.twist_gate_recovery >= 0, "twist_gate_recovery", "must be >= 0");
   requireConfig(c.twist_gate_alpha >= 0.0 && c.twist_gate_alpha < 1.0, "twist_gate_alpha", "must be in [0, 1)");
   requireConfig(c.integrity_lost_after_gated_anchors >= 0, "integrity_lost_after_gated_anchors", "must be >= 0");
   requireConfig(c.integrity_degraded_after_gated >= 0, "integrity_degraded_after_gated", "must be >= 0");
@@ -225,8 +226,8 @@ struct Localizer::Impl {
       std::ostringstream why;
       why << "squared Mahalanobis distance " << d2 << " exceeds the chi-square(" << record.m << ") gate "
           << gate[record.m];
-      const bool recover = src.kind == SourceKind::kPose && config.pose_gate_recovery > 0 &&
-                           src.gated_in_a_row >= config.pose_gate_recovery && std::isfinite(d2);
+      const int recovery = src.kind == SourceKind::kPose ? config.pose_gate_recovery : config.twist_gate_recovery;
+      const bool recover = recovery > 0 && src.gated_in_a_row >= recovery && std::isfinite(d2);
       if (!recover) {
         ++src.gated_in_a_row;
         if (src.kind == SourceKind::kPose)
@@ -235,8 +236,8 @@ struct Localizer::Impl {
         ++src.counters.gated;
         return report(std::move(v));
       }
-      // Scale S = HPH' + R by k = d2 / gate through R alone, R' = (k - 1) HPH' + k R: the pose then sits
-      // exactly on the gate and moves the state 1/k of the way a trusted one would.
+      // Scale S = HPH' + R by k = d2 / gate through R alone, R' = (k - 1) HPH' + k R: the measurement
+      // then sits exactly on the gate and moves the state 1/k of the way a trusted one would.
       const double k = d2 / gate[record.m];
       const Eigen::Matrix3d hph = innovation(history.stateAt(back), record, 1.0).S - record.R;
       record.R = (k - 1.0) * hph + k * record.R;

@@ -109,6 +109,55 @@ TEST(Gate, RecoveryNeedsTheDisagreementInARow) {
   EXPECT_TRUE(snapshot(localizer) == before);
 }
 
+// A vehicle at 10 m/s whose yaw rate steps from 0 to 0.3 rad/s (a bend entered), its odometry at its
+// sensor's noise (0.005 rad/s) and the yaw rate's process noise near a car's (0.5 rad/s^2): the first
+// twist after the step lies far beyond the gate. The twists' verdicts, and the filter's yaw rate and
+// heading error 2 s after the step (the filter starts heading 0.3 rad).
+struct YawRateStep {
+  std::vector<Verdict> verdicts;
+  double wz = 0.0, heading_error = 0.0;
+  int gatedInARow() const {
+    int n = 0;
+    while (50 + n < static_cast<int>(verdicts.size()) && verdicts[static_cast<std::size_t>(50 + n)].reason == Reason::kGated) ++n;
+    return n;
+  }
+};
+YawRateStep yawRateStep(int recovery) {
+  EkfConfig config = quietConfig();
+  config.proc_stddev_wz_c = 0.5;
+  config.twist_gate_recovery = recovery;
+  Localizer localizer = startedLocalizer(config);
+  YawRateStep out;
+  for (int k = 1; k <= 150; ++k) {
+    const Stamp now = kStart + k * kTick;
+    localizer.advanceTo(now);
+    out.verdicts.push_back(localizer.feedTwist("odom", twist(now, 10.0, k <= 50 ? 0.0 : 0.3, 0.05 * 0.05, 0.005 * 0.005)));
+  }
+  const Estimate e = *localizer.estimate();
+  out.wz = e.state[5];
+  out.heading_error = wrapAngle(e.state[2] - (0.3 + 0.3 * 100 * toSeconds(kTick)));
+  return out;
+}
+
+TEST(Gate, WithoutRecoveryATwistWhoseYawRateStepsIsRefusedUntilTheFiltersDoubtGrowsToIt) {
+  const YawRateStep s = yawRateStep(0);
+  // Refused for as long as the yaw rate's variance takes to grow to the step: the filter turns at the
+  // old rate meanwhile, and its heading stays behind by what it missed.
+  EXPECT_GE(s.gatedInARow(), 15);
+  EXPECT_LT(s.heading_error, -0.05);
+}
+
+TEST(Gate, TwistRecoveryFollowsAYawRateThatStepsBeyondTheGate) {
+  const YawRateStep s = yawRateStep(3);
+  EXPECT_EQ(s.gatedInARow(), 3);
+  EXPECT_TRUE(s.verdicts[53].applied()) << s.verdicts[53].message();
+  EXPECT_NE(s.verdicts[53].message().find("gate recovery after 3 gated in a row"), std::string::npos) << s.verdicts[53].message();
+  EXPECT_TRUE(s.verdicts.back().applied()) << s.verdicts.back().message();
+  EXPECT_LE(s.verdicts.back().mahalanobis_squared, 46.1);
+  EXPECT_NEAR(s.wz, 0.3, 0.005);
+  EXPECT_GT(s.heading_error, yawRateStep(0).heading_error / 3.0);
+}
+
 TEST(Gate, TwistGateRejectsAnImpossibleSpeed) {
   Localizer localizer = startedLocalizer();
   const Verdict v = localizer.feedTwist("odom", twist(kStart, 300.0, 0.0, 0.01, 0.01));

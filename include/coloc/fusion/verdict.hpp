@@ -69,7 +69,7 @@ struct SourceCounters {
   /// Applied, but with fewer smoothing steps than configured because the history or the queue ran
   /// out; the measurement's full information still went in.
   std::uint64_t smoothing_shortened = 0;
-  /// Applied although over the gate, at reduced weight, by gate recovery (pose_gate_recovery).
+  /// Applied although over the gate, at reduced weight, by gate recovery (pose_gate_recovery, twist_gate_recovery).
   std::uint64_t gate_recovered = 0;
   /// How well the source's covariance describes it: its normalized innovation squared
   /// d^2 = e' (H P H' + R)^-1 e at each first use (gated ones too), which a source and a filter whose
