@@ -37,8 +37,9 @@ struct EkfConfig {
   /// The same for twists: after this many twists of a source gated in a row, the next are applied at the
   /// gate's weight until one passes on its own. With the odometry's covariance at its sensor's noise and
   /// a process noise near the vehicle's dynamics, a yaw rate that steps (a bend entered, a lane changed)
-  /// lies beyond the gate, and without it every twist after the step is refused: the filter keeps the
-  /// old yaw rate and runs off the road (the twin's site C, NDT alone: 13 m mean error, 51 m at worst).
+  /// lies beyond the gate, and without it the twists after the step are refused until the filter's doubt
+  /// of its yaw rate grows to it, which NDT's poses can keep from happening: the filter keeps the old
+  /// yaw rate and runs off the road (the twin's site C, NDT alone: 13 m mean error, 51 m at worst).
   /// 0 = off (Autoware: a gated twist is dropped, always).
   int twist_gate_recovery = 0;
   /// A pose is applied at the tick nearest its stamp, up to half a tick (10 ms at 50 Hz) away; at
