@@ -34,7 +34,7 @@ std::vector<rsu_client::RsuFix> fixesFromFile(const std::string& path, const std
     char c1, c2;
     if (!(s >> t >> c1 >> x >> c2 >> y) || c1 != ',' || c2 != ',')
       throw Error(path + ":" + std::to_string(number) + ": expected 't_offset_s,x,y'");
-    fixes.push_back({fromSeconds(t), rsu, x, y, std::nullopt, std::nullopt});
+    fixes.push_back({fromSeconds(t), rsu, x, y, std::nullopt, std::nullopt, std::nullopt});
   }
   return fixes;
 }
@@ -168,7 +168,7 @@ void addRsuPublishCommand(CLI::App& app) {
     if (!from.empty()) fixes = fixesFromFile(from, rsu);
     for (int i = 0; i < generate; ++i) {  // a straight pass 3 m from the RSU, centred on it
       const double t = i / rate, along = -0.5 * speed * generate / rate + speed * t;
-      fixes.push_back({fromSeconds(t), rsu, info->position.x() + along, info->position.y() + 3.0, std::nullopt, std::nullopt});
+      fixes.push_back({fromSeconds(t), rsu, info->position.x() + along, info->position.y() + 3.0, std::nullopt, std::nullopt, std::nullopt});
     }
     if (fixes.empty()) throw Error("rsu-publish: nothing to send (give --from or --generate)");
     const rsu_client::DdsConfig config = ddsConfig(dds, rsu);

@@ -7,6 +7,7 @@
 
 #include "coloc/io/ros_messages.hpp"
 #include "io_test_support.hpp"
+#include "transform_stamped.hpp"
 
 namespace coloc::io {
 namespace {
@@ -37,7 +38,7 @@ std::vector<Sample> samples() {
   cloud.row_step = 10;
   cloud.data.assign(10, 0xAB);
   TFMessage tf;
-  tf.transforms.push_back({{fromRosTime(15, 16), "base_link"}, "lidar", {1.0, 0.0, 1.8}, Eigen::Quaterniond::Identity()});
+  tf.transforms.push_back(coloc::testing::transformStamped(fromRosTime(15, 16), "base_link", "lidar", {1.0, 0.0, 1.8}, Eigen::Quaterniond::Identity()));
   return {{MessageKind::kPoseWithCovarianceStamped, encodePoseWithCovarianceStamped(pose)},
           {MessageKind::kPoseStamped, encodePoseStamped(pose)},
           {MessageKind::kTwistWithCovarianceStamped, encodeTwistWithCovarianceStamped(twist)},

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "io_test_support.hpp"
+#include "transform_stamped.hpp"
 
 namespace coloc::io {
 namespace {
@@ -236,19 +237,9 @@ TEST(RosMessages, DecodesBigEndianMessages) {
 
 // A transform chain as a static broadcaster sends it: frames, translation and the rotation as sent.
 TEST(RosMessages, TFMessageRoundTripsEveryTransformInOrder) {
-  // Each transform built by name: GCC 12 misreads a braced temporary's string as uninitialised.
-  const auto transform = [](const std::string& parent, const std::string& child, const Eigen::Vector3d& t, const Eigen::Quaterniond& q) {
-    TransformStamped out;
-    out.header.stamp = fromRosTime(100, 5);
-    out.header.frame_id = parent;
-    out.child_frame_id = child;
-    out.translation = t;
-    out.rotation = q;
-    return out;
-  };
   TFMessage in;
-  in.transforms.push_back(transform("base_link", "sensor_kit", {0.9, -0.1, 2.0}, Eigen::Quaterniond(0.9999, 0.01, 0.0, 0.005)));
-  in.transforms.push_back(transform("sensor_kit", "velodyne_top", {0.0, 0.0, 0.1}, Eigen::Quaterniond(0.0, 0.0, 0.0, 1.0)));
+  in.transforms.push_back(coloc::testing::transformStamped(fromRosTime(100, 5), "base_link", "sensor_kit", {0.9, -0.1, 2.0}, Eigen::Quaterniond(0.9999, 0.01, 0.0, 0.005)));
+  in.transforms.push_back(coloc::testing::transformStamped(fromRosTime(100, 5), "sensor_kit", "velodyne_top", {0.0, 0.0, 0.1}, Eigen::Quaterniond(0.0, 0.0, 0.0, 1.0)));
   const TFMessage out = decodeTFMessage(encodeTFMessage(in));
   ASSERT_EQ(out.transforms.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {

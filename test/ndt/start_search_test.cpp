@@ -67,7 +67,9 @@ TEST(StartSearch, AMatchBetterThanTheOneAtAWrongPoseIsFoundAroundIt) {
   const ScanOutcome best = ndt.searchAround(p.scan, kStamp, wrong, {2.0, 4.0, 6.0}, 8, 0.0, at_wrong);
   ASSERT_TRUE(best.produced) << best.detail;
   EXPECT_LT((best.pose.pose.position.head<2>() - p.truth.topRightCorner<2, 1>()).norm(), 0.2);
-  if (at_wrong.produced) EXPECT_GT(best.alignment.nvtl, at_wrong.alignment.nvtl + 0.05);
+  if (at_wrong.produced) {
+    EXPECT_GT(best.alignment.nvtl, at_wrong.alignment.nvtl + 0.05);
+  }
   // From the truth itself, nothing around beats it.
   Pose right = wrong;
   right.position.y() -= 5.0;

@@ -57,7 +57,7 @@ TEST(NdtQualityMap, ItsFileReadsBackToTheSameMap) {
   EXPECT_EQ(back.cells(), m.cells());
   EXPECT_EQ(back.cellSize(), m.cellSize());
   EXPECT_EQ(back.defaultVariance(), m.defaultVariance());
-  for (const Eigen::Vector2d p : {Eigen::Vector2d(5, 5), Eigen::Vector2d(21, -1), Eigen::Vector2d(55, 55)}) EXPECT_EQ(back.varianceAt(p), m.varianceAt(p));
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(5, 5), Eigen::Vector2d(21, -1), Eigen::Vector2d(55, 55)}) EXPECT_EQ(back.varianceAt(p), m.varianceAt(p));
   EXPECT_EQ(back.toYaml(), m.toYaml());
 }
 

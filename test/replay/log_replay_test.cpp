@@ -19,6 +19,7 @@
 #include "coloc/replay/log_replay.hpp"
 #include "real_data.hpp"
 #include "temp_dir.hpp"
+#include "transform_stamped.hpp"
 
 namespace coloc::replay {
 namespace {
@@ -306,8 +307,8 @@ void writeMountedScanLog(const std::string& path, const Eigen::Isometry3d& mount
   kit.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Isometry3d rest = kit.inverse() * mount;
   io::TFMessage tf;
-  tf.transforms.push_back({{t0, "base_link"}, "sensor_kit", kit.translation(), Eigen::Quaterniond(kit.linear())});
-  tf.transforms.push_back({{t0, "sensor_kit"}, "velodyne_top", rest.translation(), Eigen::Quaterniond(rest.linear())});
+  tf.transforms.push_back(coloc::testing::transformStamped(t0, "base_link", "sensor_kit", kit.translation(), Eigen::Quaterniond(kit.linear())));
+  tf.transforms.push_back(coloc::testing::transformStamped(t0, "sensor_kit", "velodyne_top", rest.translation(), Eigen::Quaterniond(rest.linear())));
   tf.transforms.insert(tf.transforms.end(), extra.begin(), extra.end());
   io::BagWriter bag = io::BagWriter::create(path);
   bag.addTopic(topicOf("/tf_static", "tf2_msgs/msg/TFMessage"));

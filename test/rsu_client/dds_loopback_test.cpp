@@ -65,7 +65,7 @@ TEST(DdsLoopback, UnaddressedFixesArriveOnTheirOwnTopicNamingNoVehicle) {
   });
   FixPublisher publisher(testConfig(72), "rsu_a", false);
   ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
-  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt}, 0.00681);
+  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt, std::nullopt}, 0.00681);
   ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 1; }, std::chrono::seconds(10)));
   std::lock_guard<std::mutex> lock(mutex);
   EXPECT_FALSE(received[0].station_id.has_value());
@@ -101,7 +101,7 @@ TEST(DdsLoopback, AnUndecodableFixSampleIsCountedAndTheListenerGoesOn) {
                         std::chrono::seconds(10)));
   FixPublisher publisher(testConfig(73), "rsu_a", false);
   ASSERT_TRUE(publisher.waitForSubscribers(1, std::chrono::seconds(10)));
-  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt}, 0.00681);
+  publisher.publish({systemNow(), "rsu_a", 12.0, 3.0, std::nullopt, std::nullopt, std::nullopt}, 0.00681);
   ASSERT_TRUE(waitUntil([&] { std::lock_guard<std::mutex> l(mutex); return received.size() == 1; }, std::chrono::seconds(10)));
   const SampleCounters c = subscriber.sampleCounters();
   EXPECT_EQ(c.wrong_encapsulation, 1u);
