@@ -17,7 +17,8 @@ const std::vector<LidarModel>& lidarModels() {
   // Sigmas from the paper (Section III-C), effective ranges from its Section IV.
   // OS1-64 (64 even beams, as on roadside poles) has no published figure: the VLP-32C's, whose fixes
   // it matches on the twin from poles (median 2.6 cm); each fix's own covariance says more.
-  static const std::vector<LidarModel> models = {{"VLP-16", 0.01486, 30.0}, {"VLP-32C", 0.00681, 50.0}, {"OS1-64", 0.00681, 60.0}};
+  static const std::vector<LidarModel> models = {
+      {"VLP-16", 0.01486, 30.0, 0.2}, {"VLP-32C", 0.00681, 50.0, 0.2}, {"OS1-64", 0.00681, 60.0, 360.0 / 1024.0}};
   return models;
 }
 

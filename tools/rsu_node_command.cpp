@@ -65,6 +65,9 @@ roadside::RsuStation stationFor(const NodeSettings& s, const rsu_client::RsuInfo
   config.coverage = rsu.coverage_radius;
   config.commissioning_frames = std::max(1, s.commission);
   config.level_from_ground = s.level_from_ground;
+  // The perception's column spacing is the registry's LiDAR model's: it bounds a face's ends, each
+  // fix's doubt and what a face seen alone may lack.
+  config.perception.covariance.azimuth_step = rsu.lidar.azimuth_step_deg * M_PI / 180.0;
   return roadside::RsuStation(mountOf(rsu), config);
 }
 

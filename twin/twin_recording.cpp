@@ -459,6 +459,8 @@ TwinRecordingSummary recordTwin(const sim::Scenario& scenario, const TwinRecordi
     // looks for the vehicle in every frame cast for it.
     roadside::RsuStationConfig station_config;
     station_config.coverage = model->range + 1.5;
+    // The perception's column spacing is its LiDAR model's, as the RSU's own node takes it (stationFor).
+    station_config.perception.covariance.azimuth_step = model->azimuth_step_deg * M_PI / 180.0;
     roadside::RsuStation station(mount, station_config);
     if (options.rsu_commissioning_frames > 0) learnBackground(rsus.size(), lidar, pose, station);
     else station.commission(empty_street);

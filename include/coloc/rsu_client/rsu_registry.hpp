@@ -18,10 +18,13 @@ struct LidarModel {
   std::string name;
   double sigma;  ///< the paper's per-LiDAR figure for x and y
   double range;  ///< m, effective range for vehicle detection
+  /// deg between the LiDAR's columns: a Velodyne's 0.2 at 10 Hz, a 1024-column LiDAR's 0.35. The
+  /// roadside perception bounds a face's ends and each fix's doubt by it.
+  double azimuth_step_deg = 0.2;
 };
 
 /// The models coloc knows: VLP-16 (0.01486, 30 m) and VLP-32C (0.00681, 50 m), the paper's; OS1-64
-/// (0.00681, 60 m), a pole's 64-beam LiDAR without a published figure.
+/// (0.00681, 60 m, 1024 columns), a pole's 64-beam LiDAR without a published figure.
 const std::vector<LidarModel>& lidarModels();
 const LidarModel* findLidarModel(const std::string& name);
 
