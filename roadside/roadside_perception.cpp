@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -63,12 +64,70 @@ std::vector<std::vector<std::size_t>> clusters(const std::vector<Eigen::Vector3d
 
 }  // namespace
 
+void validate(const RoadsidePerceptionConfig& c) {
+  // A NaN passes every comparison a check makes and turns the check off (a NaN max_face_overhang
+  // would let every face seen alone through): each figure is refused by name before it is used.
+  const auto fail = [](const std::string& key, double value, const char* what) {
+    char shown[32];
+    std::snprintf(shown, sizeof shown, "%.6g", value);
+    throw Error("roadside perception: " + key + " must be " + what + ", got " + shown);
+  };
+  const auto positive = [&](const std::string& key, double v) {
+    if (!(std::isfinite(v) && v > 0.0)) fail(key, v, "finite and > 0");
+  };
+  const auto non_negative = [&](const std::string& key, double v) {
+    if (!(std::isfinite(v) && v >= 0.0)) fail(key, v, "finite and >= 0");
+  };
+  const auto finite = [&](const std::string& key, double v) {
+    if (!std::isfinite(v)) fail(key, v, "finite (<= 0 turns the check off)");
+  };
+  const auto at_least = [&](const std::string& key, int v, int least) {
+    if (v < least) fail(key, v, least == 1 ? ">= 1" : ">= 2");
+  };
+  positive("background_distance", c.background_distance);
+  positive("search_radius", c.search_radius);
+  positive("cluster_distance", c.cluster_distance);
+  positive("cut_height", c.cut_height);
+  if (c.max_points < 0) fail("max_points", c.max_points, ">= 0 (0: all)");
+  non_negative("size_margin", c.size_margin);
+  positive("attribution_radius", c.attribution_radius);
+  at_least("min_object_points", c.min_object_points, 1);
+  at_least("occlusion_points", c.occlusion_points, 1);
+  positive("occlusion_top", c.occlusion_top);
+  if (!(c.background_occlusion_share > 0.0 && c.background_occlusion_share <= 1.0))
+    fail("background_occlusion_share", c.background_occlusion_share, "in (0, 1]");
+  finite("max_heading_disagreement", c.max_heading_disagreement);
+  non_negative("max_face_shortfall", c.max_face_shortfall);
+  non_negative("max_width_face_shortfall", c.max_width_face_shortfall);
+  if (!(c.oblique_face >= 0.0 && c.oblique_face < 0.5 * M_PI)) fail("oblique_face", c.oblique_face, "in [0, pi/2) rad");
+  positive("max_face_placement_error", c.max_face_placement_error);
+  finite("max_face_overhang", c.max_face_overhang);
+  at_least("min_fit_points", c.min_fit_points, 2);  // the L-shape fit's least
+  positive("road.cell", c.road.cell);
+  non_negative("road.min_range", c.road.min_range);
+  if (!(std::isfinite(c.road.max_range) && c.road.max_range > c.road.min_range)) fail("road.max_range", c.road.max_range, "finite and > road.min_range");
+  positive("road.band", c.road.band);
+  at_least("road.min_points", c.road.min_points, 1);
+  non_negative("road.smoothing", c.road.smoothing);
+  if (!(c.lshape.angle_step_deg > 0.0 && c.lshape.angle_step_deg <= 90.0)) fail("lshape.angle_step_deg", c.lshape.angle_step_deg, "in (0, 90]");
+  positive("lshape.closeness_floor", c.lshape.closeness_floor);
+  non_negative("lshape.edge_band", c.lshape.edge_band);
+  non_negative("covariance.range_noise", c.covariance.range_noise);
+  positive("covariance.azimuth_step", c.covariance.azimuth_step);
+  non_negative("covariance.size_step", c.covariance.size_step);
+  non_negative("covariance.heading_floor", c.covariance.heading_floor);
+  non_negative("covariance.floor", c.covariance.floor);
+  positive("covariance.scale", c.covariance.scale);
+  validate(c.body_size);
+}
+
 RoadsidePerception::RoadsidePerception(const std::vector<Eigen::Vector3f>& reference_frame, const RsuMount& mount,
                                        const RoadsidePerceptionConfig& config)
     : impl_(std::make_unique<Impl>()) {
   if (reference_frame.empty()) throw Error("roadside perception: the reference (background) frame is empty");
-  if (!(std::isfinite(config.background_distance) && config.background_distance > 0.0))
-    throw Error("roadside perception: background_distance must be finite and > 0 m, got " + std::to_string(config.background_distance));
+  validate(config);
+  if (!(mount.position.allFinite() && std::isfinite(mount.yaw) && std::isfinite(mount.roll) && std::isfinite(mount.pitch)))
+    throw Error("roadside perception: the mount's position and angles must be finite");
   impl_->config = config;
   impl_->mount = mount;
   impl_->background.emplace(reference_frame, config.background_distance);

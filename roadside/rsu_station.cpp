@@ -58,7 +58,7 @@ RsuStation::RsuStation(const RsuMount& mount, RsuStationConfig config) {
     throw Error("RSU station: coverage and max_cam_age must be > 0, forget_after at least max_cam_age");
   if (config.commissioning_frames < 1 || config.refresh_frames < 1 || config.learn_every < 1)
     throw Error("RSU station: commissioning_frames, refresh_frames and learn_every must be >= 1");
-  validate(config.perception.body_size);
+  validate(config.perception);  // before commissioning, not at the first frame after it
   impl_ = std::make_unique<Impl>(mount, config);
 }
 

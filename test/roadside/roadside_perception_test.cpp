@@ -3,14 +3,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "coloc/core/error.hpp"
 #include "coloc/sim/error_sources.hpp"
 #include "coloc/sim/lidar_model.hpp"
 #include "coloc/roadside/roadside_perception.hpp"
+#include "coloc/roadside/rsu_station.hpp"
 #include "coloc/sim/vehicle_body.hpp"
 
 namespace coloc::roadside {
@@ -159,6 +163,58 @@ TEST(RoadsidePerception, ABackgroundDistanceThatIsNotAPositiveNumberIsRefusedByN
       EXPECT_NE(std::string(e.what()).find("background_distance must be finite and > 0"), std::string::npos) << e.what();
     }
   }
+}
+
+// Every figure of the configuration, NaN: a NaN passes no comparison, and would turn a check off
+// rather than fail it (a NaN max_face_overhang let any face seen alone through). Each is refused by
+// its own name, by the perception and by an RSU station before it commissions anything.
+TEST(RoadsidePerception, ANotANumberInAnyFigureOfItsConfigurationIsRefusedByName) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  using Set = std::function<void(RoadsidePerceptionConfig&)>;
+  const std::vector<std::pair<std::string, Set>> figures = {
+      {"background_distance", [&](auto& c) { c.background_distance = nan; }},
+      {"search_radius", [&](auto& c) { c.search_radius = nan; }},
+      {"cluster_distance", [&](auto& c) { c.cluster_distance = nan; }},
+      {"cut_height", [&](auto& c) { c.cut_height = nan; }},
+      {"size_margin", [&](auto& c) { c.size_margin = nan; }},
+      {"attribution_radius", [&](auto& c) { c.attribution_radius = nan; }},
+      {"occlusion_top", [&](auto& c) { c.occlusion_top = nan; }},
+      {"background_occlusion_share", [&](auto& c) { c.background_occlusion_share = nan; }},
+      {"max_heading_disagreement", [&](auto& c) { c.max_heading_disagreement = nan; }},
+      {"max_face_shortfall", [&](auto& c) { c.max_face_shortfall = nan; }},
+      {"max_width_face_shortfall", [&](auto& c) { c.max_width_face_shortfall = nan; }},
+      {"oblique_face", [&](auto& c) { c.oblique_face = nan; }},
+      {"max_face_placement_error", [&](auto& c) { c.max_face_placement_error = nan; }},
+      {"max_face_overhang", [&](auto& c) { c.max_face_overhang = nan; }},
+      {"road.cell", [&](auto& c) { c.road.cell = nan; }},
+      {"road.max_range", [&](auto& c) { c.road.max_range = nan; }},
+      {"road.band", [&](auto& c) { c.road.band = nan; }},
+      {"lshape.closeness_floor", [&](auto& c) { c.lshape.closeness_floor = nan; }},
+      {"lshape.angle_step_deg", [&](auto& c) { c.lshape.angle_step_deg = nan; }},
+      {"covariance.azimuth_step", [&](auto& c) { c.covariance.azimuth_step = nan; }},
+      {"covariance.scale", [&](auto& c) { c.covariance.scale = nan; }},
+      {"covariance.floor", [&](auto& c) { c.covariance.floor = nan; }},
+      {"max_shortfall", [&](auto& c) { c.body_size.max_shortfall = nan; }},
+      {"min_fit_points", [&](auto& c) { c.min_fit_points = 1; }},
+      {"occlusion_points", [&](auto& c) { c.occlusion_points = 0; }},
+  };
+  for (const auto& [key, set] : figures) {
+    RoadsidePerceptionConfig config;
+    set(config);
+    try {
+      RoadsidePerception refused({Eigen::Vector3f(10.0f, 0.0f, 0.0f)}, RsuMount{}, config);
+      ADD_FAILURE() << key << " out of range was taken";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key + " must be"), std::string::npos) << e.what();
+    }
+    RsuStationConfig station;
+    station.perception = config;
+    EXPECT_THROW(RsuStation(RsuMount{}, station), Error) << key;
+  }
+  RsuMount tilted_by_nan;
+  tilted_by_nan.pitch = nan;
+  EXPECT_THROW(RoadsidePerception({Eigen::Vector3f(10.0f, 0.0f, 0.0f)}, tilted_by_nan), Error);
+  EXPECT_NO_THROW(validate(RoadsidePerceptionConfig{}));
 }
 
 TEST(RoadsidePerception, NoVehicleInViewIsNotFound) {

@@ -100,6 +100,10 @@ struct RoadsidePerceptionConfig {
   FixCovarianceModel covariance;
 };
 
+/// Throws coloc::Error naming the first key that is out of range or not finite, and its value (the
+/// constructor of RoadsidePerception calls it, and so does an RSU station's).
+void validate(const RoadsidePerceptionConfig& config);
+
 /// Where the RSU's LiDAR stands: map position of the sensor (z = height above the road), heading, and
 /// its tilt (a pole's LiDAR is pitched down towards the road; 1.9 deg at 40 m puts a point 1.3 m off in
 /// height, the height cut then keeps the wrong part of the body).
