@@ -7,11 +7,12 @@
 
 namespace coloc::ndt {
 
-struct AlignmentMemo::Entry {
+template <typename T>
+struct AlignmentMemo::Slot {
   // Held so that no other scan or target can take their addresses while the key names them.
   std::shared_ptr<const PointCloud> scan;
   std::shared_ptr<const NdtTarget> target;
-  std::optional<ScanOutcome> outcome;
+  std::optional<T> value;
   std::exception_ptr failure;
   bool done = false;
   std::condition_variable ready;
@@ -43,49 +44,66 @@ std::size_t AlignmentMemo::KeyHash::operator()(const Key& k) const {
   return static_cast<std::size_t>(h ^ std::hash<std::string>()(k.config));
 }
 
+template <typename T>
+T AlignmentMemo::share(Table<T>& table, const Key& key, const Question& q, std::uint64_t& asked, std::uint64_t& computed,
+                       const std::function<T()>& compute) {
+  std::shared_ptr<Slot<T>> slot;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ++asked;
+    const auto found = table.find(key);
+    if (found != table.end()) {
+      slot = found->second;
+      slot->ready.wait(lock, [&] { return slot->done; });
+      if (slot->failure) std::rethrow_exception(slot->failure);
+      return *slot->value;
+    }
+    slot = std::make_shared<Slot<T>>();
+    slot->scan = q.scan;
+    slot->target = q.target;
+    table.emplace(key, slot);
+    ++computed;
+  }
+  std::exception_ptr failure;
+  std::optional<T> value;
+  try {
+    value = compute();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    slot->done = true;
+    if (failure) {
+      slot->failure = failure;
+      table.erase(key);  // not kept: a later question computes afresh
+    } else {
+      slot->value = value;
+    }
+  }
+  slot->ready.notify_all();
+  if (failure) std::rethrow_exception(failure);
+  return std::move(*value);
+}
+
 ScanOutcome AlignmentMemo::answer(const std::string& config, const Question& q, const std::function<ScanOutcome()>& compute) {
   Key key{config, q.scan.get(), q.target.get(), q.stamp, {}};
   const double values[9] = {q.predicted.position.x(), q.predicted.position.y(), q.predicted.position.z(),
                             q.predicted.orientation.w(), q.predicted.orientation.x(), q.predicted.orientation.y(),
                             q.predicted.orientation.z(), q.vx, q.wz};
   for (int i = 0; i < 9; ++i) key.bits[i] = bitsOf(values[i]);
-  std::shared_ptr<Entry> entry;
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    ++stats_.asked;
-    const auto found = entries_.find(key);
-    if (found != entries_.end()) {
-      entry = found->second;
-      entry->ready.wait(lock, [&] { return entry->done; });
-      if (entry->failure) std::rethrow_exception(entry->failure);
-      return *entry->outcome;
-    }
-    entry = std::make_shared<Entry>();
-    entry->scan = q.scan;
-    entry->target = q.target;
-    entries_.emplace(key, entry);
-    ++stats_.computed;
-  }
-  std::exception_ptr failure;
-  std::optional<ScanOutcome> outcome;
-  try {
-    outcome = compute();
-  } catch (...) {
-    failure = std::current_exception();
-  }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    entry->done = true;
-    if (failure) {
-      entry->failure = failure;
-      entries_.erase(key);  // not kept: a later question computes afresh
-    } else {
-      entry->outcome = outcome;
-    }
-  }
-  entry->ready.notify_all();
-  if (failure) std::rethrow_exception(failure);
-  return std::move(*outcome);
+  return share<ScanOutcome>(entries_, key, q, stats_.asked, stats_.computed, compute);
+}
+
+std::shared_ptr<const PointCloud> AlignmentMemo::preprocessed(const std::string& config, const std::shared_ptr<const PointCloud>& scan, double vx,
+                                                              double wz, const std::function<PointCloud()>& compute) {
+  Key key{config, scan.get(), nullptr, 0, {}};
+  key.bits[0] = bitsOf(vx);
+  key.bits[1] = bitsOf(wz);
+  Question q;
+  q.scan = scan;
+  return share<std::shared_ptr<const PointCloud>>(preprocessed_, key, q, stats_.preprocessings_asked, stats_.preprocessings_computed,
+                                                  [&] { return std::make_shared<const PointCloud>(compute()); });
 }
 
 AlignmentMemoStats AlignmentMemo::stats() const {
@@ -97,15 +115,20 @@ std::string configFingerprint(const NdtPoseSourceConfig& c) {
   // Field by field (padding bytes are not part of a value). A field added to these structs must be
   // added here too, or sources differing only in it would share outcomes: the sizes below catch it.
   static_assert(sizeof(NdtConfig) == 192, "NdtConfig changed: fingerprint the new field");
-  static_assert(sizeof(PreprocessConfig) == 48, "PreprocessConfig changed: fingerprint the new field");
   static_assert(sizeof(MapUpdateConfig) == 24, "MapUpdateConfig changed: fingerprint the new field");
   std::string out;
   const NdtConfig& n = c.ndt;
   append(out, n.backend, n.neighborhood, n.resolution, n.step_size, n.transformation_epsilon, n.max_iterations, n.outlier_ratio, n.threads,
          n.nvtl_threshold, n.max_oscillations, n.covariance, n.fixed_covariance, n.covariance_floor, n.score_temperature, n.score_yaw_offset_deg);
-  const PreprocessConfig& p = c.preprocess;
-  append(out, p.min_range, p.max_range, p.deskew, p.voxel_size, p.max_points, p.seed);
+  out += preprocessFingerprint(c.preprocess);
   append(out, c.map.radius, c.map.update_distance, c.map.background, c.lidar_pose);
+  return out;
+}
+
+std::string preprocessFingerprint(const PreprocessConfig& p) {
+  static_assert(sizeof(PreprocessConfig) == 48, "PreprocessConfig changed: fingerprint the new field");
+  std::string out;
+  append(out, p.min_range, p.max_range, p.deskew, p.voxel_size, p.max_points, p.seed);
   return out;
 }
 

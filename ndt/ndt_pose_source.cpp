@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
+
 #include "coloc/ndt/alignment_memo.hpp"
 
 namespace coloc::ndt {
@@ -15,6 +17,14 @@ Eigen::Matrix4d matrixOf(const Pose& pose) {
   return T;
 }
 
+// The deskew's twist is taken to 1 mm/s and 1e-5 rad/s: over a 0.1 s sweep the rounding moves a point
+// by at most 0.05 mm (0.03 mm at 60 m for the turn), a four-hundredth of a LiDAR's range noise. Replays
+// of one log whose filters agree that closely preprocess each scan once (AlignmentMemo): on the quick
+// experiment's drives 46 % of the preprocessing, which was a sixth of the full run's time.
+constexpr double kDeskewSpeedStep = 1e-3, kDeskewYawRateStep = 1e-5;
+
+double roundedTo(double value, double step) { return std::isfinite(value) ? std::round(value / step) * step : value; }
+
 }  // namespace
 
 NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std::shared_ptr<TargetCache> targets,
@@ -22,7 +32,8 @@ NdtPoseSource::NdtPoseSource(TileMap map, const NdtPoseSourceConfig& config, std
     : config_((validate(config), config)),
       map_(std::move(map), config.ndt, config.map, std::move(targets)),
       alignments_(std::move(alignments)),
-      fingerprint_(alignments_ ? configFingerprint(config_) : std::string()) {
+      fingerprint_(alignments_ ? configFingerprint(config_) : std::string()),
+      preprocess_fingerprint_(alignments_ ? preprocessFingerprint(config_.preprocess) : std::string()) {
   const Vector6d& p = config.lidar_pose;
   Pose lidar;
   lidar.position = p.head<3>();
@@ -42,6 +53,8 @@ ScanOutcome NdtPoseSource::process(const std::shared_ptr<const PointCloud>& scan
 
 ScanOutcome NdtPoseSource::process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& predicted,
                                    double vx, double wz) {
+  vx = roundedTo(vx, kDeskewSpeedStep);
+  wz = roundedTo(wz, kDeskewYawRateStep);
   ++counters_.scans;
   // The map moves with the prediction whether or not the outcome is shared: its state is this source's.
   map_.update(predicted.position.head<2>());
@@ -57,19 +70,20 @@ ScanOutcome NdtPoseSource::process(const PointCloud& scan, const std::shared_ptr
     bool computed = false;
     out = alignments_->answer(fingerprint_, {*shared, stamp, target, predicted, vx, wz}, [&] {
       computed = true;
-      return match(scan, stamp, predicted, vx, wz, *target);
+      return match(*alignments_->preprocessed(preprocess_fingerprint_, *shared, vx, wz,
+                                              [&] { return preprocessScan(scan, config_.preprocess, vx, wz); }),
+                   stamp, predicted, *target);
     });
     if (!computed) ++counters_.shared;
   } else {
-    out = match(scan, stamp, predicted, vx, wz, *target);
+    out = match(preprocessScan(scan, config_.preprocess, vx, wz), stamp, predicted, *target);
   }
   count(out);
   return out;
 }
 
-ScanOutcome NdtPoseSource::match(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz, const NdtTarget& target) const {
+ScanOutcome NdtPoseSource::match(const PointCloud& cloud, Stamp stamp, const Pose& predicted, const NdtTarget& target) const {
   ScanOutcome out;
-  const PointCloud cloud = preprocessScan(scan, config_.preprocess, vx, wz);
   out.points_used = cloud.size();
   if (cloud.empty()) {
     out.alignment.rejection = AlignRejection::kEmptySource;

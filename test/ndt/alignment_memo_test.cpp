@@ -70,7 +70,7 @@ TEST(AlignmentMemo, AnyDifferenceInTheQuestionIsComputedAfresh) {
   Pose nudged = pair.predicted;
   nudged.position.x() = std::nextafter(nudged.position.x(), 1e9);  // one bit
   source.process(pair.scan, 100, nudged, 5.0, 0.1);
-  source.process(pair.scan, 100, pair.predicted, std::nextafter(5.0, 6.0), 0.1);  // the twist deskews
+  source.process(pair.scan, 100, pair.predicted, 5.001, 0.1);  // the twist deskews (to the millimetre per second)
   source.process(pair.scan, 101, pair.predicted, 5.0, 0.1);                       // the stamp is in the pose
   const auto copy = std::make_shared<const PointCloud>(*pair.scan);  // equal, but another scan
   source.process(copy, 100, pair.predicted, 5.0, 0.1);
@@ -84,6 +84,31 @@ TEST(AlignmentMemo, AnyDifferenceInTheQuestionIsComputedAfresh) {
   NdtPoseSource apart = pair.source(memo, nullptr, true);  // an equal target, but its own
   apart.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
   EXPECT_EQ(memo->stats().computed, 7u);
+}
+
+// A twist within the deskew's rounding (1 mm/s, 1e-5 rad/s) is the same twist: the same question.
+// Sources whose predictions differ match afresh, but the scan is preprocessed once for them all, and
+// each gets the bytes a source alone computes.
+TEST(AlignmentMemo, TwistsThatRoundAlikeShareTheScansPreprocessingWhateverThePrediction) {
+  const RealPair pair;
+  auto memo = std::make_shared<AlignmentMemo>();
+  NdtPoseSource first = pair.source(memo), second = pair.source(memo), alone = pair.source(nullptr);
+  first.process(pair.scan, 100, pair.predicted, 5.0, 0.1);
+  const ScanOutcome same = second.process(pair.scan, 100, pair.predicted, 5.0004, 0.100004);
+  EXPECT_EQ(memo->stats().computed, 1u);
+  EXPECT_EQ(second.counters().shared, 1u);
+  expectSameOutcome(same, alone.process(*pair.scan, 100, pair.predicted, 5.0, 0.1));
+  Pose nudged = pair.predicted;
+  nudged.position.x() += 0.05;
+  const ScanOutcome elsewhere = second.process(pair.scan, 100, nudged, 4.9996, 0.1);
+  EXPECT_EQ(memo->stats().computed, 2u);
+  expectSameOutcome(elsewhere, alone.process(*pair.scan, 100, nudged, 5.0, 0.1));
+  EXPECT_EQ(memo->stats().preprocessings_asked, 2u);
+  EXPECT_EQ(memo->stats().preprocessings_computed, 1u);
+  // A twist a step away deskews differently.
+  second.process(pair.scan, 100, nudged, 5.002, 0.1);
+  EXPECT_EQ(memo->stats().preprocessings_computed, 2u);
+  EXPECT_EQ(memo->stats().computed, 3u);
 }
 
 TEST(AlignmentMemo, AQuestionAskedTwiceAtOnceIsComputedOnce) {

@@ -6,8 +6,13 @@
 // treat differently; until then each scan is matched once instead of once per replay, and every replay
 // still gets the bytes it would have computed itself.
 //
+// The scan preprocessed (cropped, deskewed, thinned) is shared the same way, by scan object, settings
+// and deskew twist: replays whose filters agree on the twist to the deskew's resolution (ndt_pose_source
+// rounds it) preprocess a scan once, however their predictions differ.
+//
 // Thread-safe: a question being answered for one source is waited for by the others. Memory: an outcome
-// per question (a few hundred bytes); the scans and targets asked about stay alive while the memo does.
+// per question (a few hundred bytes) and a preprocessed scan per twist asked (at most
+// PreprocessConfig::max_points points); the scans and targets asked about stay alive while the memo does.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -22,6 +27,8 @@ namespace coloc::ndt {
 struct AlignmentMemoStats {
   std::uint64_t asked = 0;     ///< questions put to the memo
   std::uint64_t computed = 0;  ///< of them, answered by computing (the rest were shared)
+  std::uint64_t preprocessings_asked = 0;     ///< scans asked for preprocessed (by the computed questions)
+  std::uint64_t preprocessings_computed = 0;  ///< of them, preprocessed here (the rest were shared)
 };
 
 class AlignmentMemo {
@@ -37,6 +44,10 @@ class AlignmentMemo {
   /// `compute()`'s, the first time it is asked; the same outcome, copied, every later time. An
   /// exception from `compute()` reaches every caller waiting for it and is not kept.
   ScanOutcome answer(const std::string& config, const Question& question, const std::function<ScanOutcome()>& compute);
+  /// `compute()`'s preprocessed scan for `scan` under `config` (preprocessFingerprint) and the twist
+  /// `vx`, `wz`, the first time it is asked; the same cloud, shared, every later time.
+  std::shared_ptr<const PointCloud> preprocessed(const std::string& config, const std::shared_ptr<const PointCloud>& scan, double vx, double wz,
+                                                 const std::function<PointCloud()>& compute);
   AlignmentMemoStats stats() const;
 
  private:
@@ -51,13 +62,21 @@ class AlignmentMemo {
   struct KeyHash {
     std::size_t operator()(const Key& k) const;
   };
-  struct Entry;
+  template <typename T>
+  struct Slot;
+  template <typename T>
+  using Table = std::unordered_map<Key, std::shared_ptr<Slot<T>>, KeyHash>;
+  template <typename T>
+  T share(Table<T>& table, const Key& key, const Question& question, std::uint64_t& asked, std::uint64_t& computed, const std::function<T()>& compute);
   mutable std::mutex mutex_;
-  std::unordered_map<Key, std::shared_ptr<Entry>, KeyHash> entries_;
+  Table<ScanOutcome> entries_;
+  Table<std::shared_ptr<const PointCloud>> preprocessed_;
   AlignmentMemoStats stats_;
 };
 
 /// Every setting of `config` as bytes: equal exactly when two pose sources compute the same.
 std::string configFingerprint(const NdtPoseSourceConfig& config);
+/// The preprocessing's settings as bytes: equal exactly when two sources preprocess a scan alike.
+std::string preprocessFingerprint(const PreprocessConfig& config);
 
 }  // namespace coloc::ndt

@@ -95,7 +95,8 @@ class NdtPoseSource {
  private:
   /// `shared`: the scan as shared, to ask alignments_ about; null: computed here.
   ScanOutcome process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& predicted, double vx, double wz);
-  ScanOutcome match(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz, const NdtTarget& target) const;
+  /// The preprocessed `cloud` matched from the prediction.
+  ScanOutcome match(const PointCloud& cloud, Stamp stamp, const Pose& predicted, const NdtTarget& target) const;
   void count(const ScanOutcome& out);
   /// The scan preprocessed once and matched from each base pose (the first also reported in `first`),
   /// the best accepted match by NVTL kept; the map is moved to `near`. `as_scan`: counted as one of
@@ -110,6 +111,7 @@ class NdtPoseSource {
   DynamicMap map_;
   std::shared_ptr<AlignmentMemo> alignments_;
   std::string fingerprint_;  ///< of config_, for alignments_
+  std::string preprocess_fingerprint_;  ///< of config_.preprocess, for alignments_
   Eigen::Matrix4d base_to_lidar_;
   NdtPoseSourceCounters counters_;
 };
