@@ -813,6 +813,13 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       for (const Job& j : jobs) writeReplayConfig(j, rec.out_dir + "/replays");
     const auto t1 = Clock::now();
     runJobs(jobs, config.jobs);
+    {
+      const ndt::AlignmentMemoStats shared = cache->alignments()->stats();
+      results.timing.matches_asked += shared.asked;
+      results.timing.matches_computed += shared.computed;
+      results.timing.preprocessings_asked += shared.preprocessings_asked;
+      results.timing.preprocessings_computed += shared.preprocessings_computed;
+    }
     for (Job& j : jobs) {
       results.timing.replay += j.run.replay_seconds;
       if (drive.variant == kNoiseCalibrationDrive) {

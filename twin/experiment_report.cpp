@@ -818,7 +818,12 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
      << fmt("%.1f M rays/s, ", tm.rays / std::max(tm.ray_casting, 1e-9) * 1e-6) << tm.reused_sweeps
      << " sweeps and frames reused from an earlier drive of the site; " << fmt("the LiDARs' noise and dropouts %.1f s, ", tm.lidar)
      << fmt("roadside perception %.2f s), ", tm.perception) << tm.replays << fmt(" replays through NDT + EKF %.0f s of CPU time ", tm.replay)
-     << "(" << c.jobs << " side by side).\n\n"
+     << "(" << c.jobs << " side by side)";
+  if (tm.matches_asked > 0)
+    md << "; of the " << tm.matches_asked << " scans they gave NDT, " << tm.matches_computed
+       << " were matched (the rest shared by replays identical up to then) and " << tm.preprocessings_computed
+       << " preprocessed (shared by replays that agree on the deskew's twist)";
+  md << ".\n\n"
      << "## Files\n\n- ";
   const char* separator = "";
   for (const char* t : kTables)

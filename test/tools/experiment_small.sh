@@ -80,4 +80,11 @@ parts=$(grep -A5 "The same per component" "$work/out/README.md" | grep '^| small
 num='[0-9][0-9.e+-]*'
 echo "$parts" | grep -qE "^\| small_site( \| $num / $num / $num)+ \|\$" ||
   { echo "FAIL: the per-component NIS row '$parts' is not along / across / yaw for each configuration"; exit 1; }
-echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected; NDT's NIS: $nis; per component: $parts"
+# The replays of a drive share NDT's work (ndt::AlignmentMemo): fewer matches than scans given it, and
+# fewer preprocessings than matches, yet some of each.
+shared=$(grep -oE 'of the [0-9]+ scans they gave NDT, [0-9]+ were matched \(.*\) and [0-9]+ preprocessed' "$work/out/README.md") ||
+  { echo "FAIL: the run time does not say what the replays shared"; exit 1; }
+read -r asked matched preprocessed <<< "$(echo "$shared" | grep -oE '[0-9]+' | tr '\n' ' ')"
+[ "$matched" -gt 0 ] && [ "$matched" -lt "$asked" ] && [ "$preprocessed" -gt 0 ] && [ "$preprocessed" -lt "$matched" ] ||
+  { echo "FAIL: $asked scans, $matched matched, $preprocessed preprocessed: the replays did not share what they could"; exit 1; }
+echo "the experiment wrote its tables and figures; fusion beat NDT alone; the per-site change carries its standard error $expected; NDT's NIS: $nis; per component: $parts; of $asked scans $matched matched, $preprocessed preprocessed"
