@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 #include <string>
 #include <unordered_map>
 
 #include "coloc/core/error.hpp"
+#include "coloc/core/number_text.hpp"
 #include "coloc/roadside/road_surface.hpp"
 #include "near_points.hpp"
 
@@ -68,9 +68,7 @@ void validate(const RoadsidePerceptionConfig& c) {
   // A NaN passes every comparison a check makes and turns the check off (a NaN max_face_overhang
   // would let every face seen alone through): each figure is refused by name before it is used.
   const auto fail = [](const std::string& key, double value, const char* what) {
-    char shown[32];
-    std::snprintf(shown, sizeof shown, "%.6g", value);
-    throw Error("roadside perception: " + key + " must be " + what + ", got " + shown);
+    throw Error("roadside perception: " + key + " must be " + what + ", got " + exactNumberText(value));
   };
   const auto positive = [&](const std::string& key, double v) {
     if (!(std::isfinite(v) && v > 0.0)) fail(key, v, "finite and > 0");

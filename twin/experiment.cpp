@@ -817,7 +817,6 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       const ndt::AlignmentMemoStats shared = cache->alignments()->stats();
       results.timing.matches_asked += shared.asked;
       results.timing.matches_computed += shared.computed;
-      results.timing.preprocessings_asked += shared.preprocessings_asked;
       results.timing.preprocessings_computed += shared.preprocessings_computed;
     }
     for (Job& j : jobs) {

@@ -78,8 +78,8 @@ struct ExperimentTiming {
   std::uint64_t rays = 0, reused_sweeps = 0, replays = 0;           ///< rays cast; sweeps and frames taken from an earlier drive's
   double driven_seconds = 0.0;  ///< s of simulated driving
   /// What a drive's replays shared (ndt::AlignmentMemo, summed over the drives): NDT's matches asked and
-  /// computed, and of the computed, the scans' preprocessings asked and computed.
-  std::uint64_t matches_asked = 0, matches_computed = 0, preprocessings_asked = 0, preprocessings_computed = 0;
+  /// computed, and the scans' preprocessings computed (one asked per match computed).
+  std::uint64_t matches_asked = 0, matches_computed = 0, preprocessings_computed = 0;
 };
 
 struct SiteInfo {
