@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
+#include <array>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "builtin_scenarios.hpp"
 #include "coloc/core/error.hpp"
 #include "coloc/pipeline/config.hpp"
 #include "coloc/sim/scene.hpp"
+#include "coloc/twin/experiment.hpp"
 #include "coloc/twin/experiment_config.hpp"
 #include "coloc/twin/experiment_report.hpp"
 
@@ -155,6 +159,77 @@ TEST(ErrorInCoverage, PaperMetricIsTheMeanOfEachBinsMinimumAndIgnoresTheRestOfTh
   EXPECT_EQ(near.samples, 9u);
   EXPECT_NEAR(near.paper, 0.5 * (0.12 + 0.13), 1e-12);
   EXPECT_EQ(errorInCoverage(r, -1.0, 2.0).samples, 0u);
+}
+
+
+// A run with one error everywhere, all within coverage: both metrics are that error.
+ExperimentRun flatRun(const std::string& site, int trial, const std::string& lidar, double delay, double loss, double error) {
+  ExperimentRun r;
+  r.site = site, r.trial = trial, r.lidar = lidar, r.delay = delay, r.loss = loss;
+  for (int i = 0; i < 20; ++i) r.along.push_back(i * 1.0), r.to_rsu.push_back(1.0), r.error.push_back(error);
+  return r;
+}
+
+std::string fileText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The network figure on the sites where NDT falls short is the ratio of their means, with the
+// standard error of their drives' own changes: one site where NDT is good (2 cm) and two where it falls
+// short (10 and 8 cm); at 30 ms and 20 % loss the fused error grows by 10, 20 and 30 % on one's three
+// drives and 20 % on each of the other's.
+TEST(ExperimentReport, TheNetworkChangeIsPooledOverTheSitesWhereNdtFallsShortWithItsStandardError) {
+  ExperimentResults results;
+  ExperimentConfig& c = results.config;
+  c.sites = {"site_x", "site_y", "site_z"};
+  c.trials = c.network_trials = 3;
+  c.lidars = {"VLP-16"};
+  c.delays = {0.0, 0.03};
+  c.losses = {0.0, 0.2};
+  c.network = true;
+  c.smoother = c.calibration = c.sweeps = false;
+  const std::map<std::string, std::pair<double, double>> site_errors = {{"site_x", {0.02, 0.01}}, {"site_y", {0.10, 0.02}}, {"site_z", {0.08, 0.01}}};
+  const std::map<std::string, std::array<double, 3>> growth = {{"site_x", {1.1, 1.1, 1.1}}, {"site_y", {1.1, 1.2, 1.3}}, {"site_z", {1.2, 1.2, 1.2}}};
+  for (const auto& [site, errors] : site_errors) {
+    SiteInfo info;
+    info.name = site;
+    info.drive_length = 20.0;
+    info.cruise_speed = 10.0;
+    results.sites.push_back(info);
+    for (int t = 0; t < 3; ++t) {
+      results.runs.push_back(flatRun(site, t, "", 0.0, 0.0, errors.first));
+      for (double delay : c.delays)
+        for (double loss : c.losses)
+          results.runs.push_back(flatRun(site, t, "VLP-16", delay, loss, errors.second * (delay > 0.0 && loss > 0.0 ? growth.at(site)[t] : 1.0)));
+    }
+  }
+  const std::string dir = ::testing::TempDir() + "/coloc_network_report";
+  std::filesystem::create_directories(dir);
+  writeExperimentReport(results, dir, "coloc experiment");
+  std::map<std::string, double> change;  // scope -> the change at 30 ms and 20 % loss, paper's metric
+  std::istringstream csv(fileText(dir + "/network.csv"));
+  for (std::string line; std::getline(csv, line);) {
+    std::vector<std::string> field;  // site, lidar, delay_s, loss, error_paper_m, error_mean_m, change_pct, ...
+    std::istringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) field.push_back(f);
+    if (field.size() == 9 && field[1] == "VLP-16" && field[2] == "0.03" && field[3] == "0.2") change[field[0]] = std::stod(field[6]);
+  }
+  // y and z: (3 x 0.02 x 1.2 + 3 x 0.01 x 1.2) / (3 x 0.02 + 3 x 0.01) = 1.2; all three: 0.141 / 0.12.
+  ASSERT_EQ(change.count("ndt_falls_short"), 1u) << fileText(dir + "/network.csv");
+  EXPECT_NEAR(change["ndt_falls_short"], 20.0, 1e-9);
+  EXPECT_NEAR(change["all"], 100.0 * (0.141 / 0.12 - 1.0), 1e-9);
+  EXPECT_NEAR(change["site_x"], 10.0, 1e-9);
+  // The drives' changes 10, 20, 30, 20, 20, 20 %: sd sqrt(40 / 5), over sqrt(6): 2.6 points.
+  const std::string report = fileText(dir + "/README.md");
+  EXPECT_NE(report.find("| where NDT falls short (site_y, site_z) | VLP-16 | 1.80 cm | +20.0 % (± 2.6) |"), std::string::npos) << report;
+  // With every site where NDT falls short, the pooled row would be "all sites" again: there is none.
+  results.sites.erase(results.sites.begin());
+  writeExperimentReport(results, dir, "coloc experiment");
+  EXPECT_EQ(fileText(dir + "/network.csv").find("ndt_falls_short"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
