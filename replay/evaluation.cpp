@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "coloc/replay/accurate_places.hpp"
+
 namespace coloc::replay {
 
 std::optional<TruthSample> truthAt(const std::vector<io::TrajectoryPoint>& truth, Stamp t, Duration max_gap) {
@@ -56,7 +58,8 @@ std::vector<ErrorSample> evaluateAt(const std::vector<io::TrajectoryPoint>& esti
 }
 
 InputComparison compareWithInput(const std::vector<ErrorSample>& input, const std::vector<ErrorSample>& fused_at_input,
-                                 const std::vector<ErrorSample>& settled_at_input, double stretch_length, double accurate_below) {
+                                 const std::vector<ErrorSample>& settled_at_input, double stretch_length, double accurate_below,
+                                 const AccuratePlaces* places) {
   InputComparison c;
   c.stretch_length = stretch_length;
   c.accurate_below = accurate_below;
@@ -85,6 +88,16 @@ InputComparison compareWithInput(const std::vector<ErrorSample>& input, const st
   const double n = static_cast<double>(pairs.size());
   c.input_mean /= n, c.fused_mean /= n, c.settled_mean /= n, c.mean_square_xy /= n, c.yaw_mean /= n;
   for (const Triple& p : pairs) c.yaw_variance += (p.input->heading_error - c.yaw_mean) * (p.input->heading_error - c.yaw_mean) / n;
+  if (places)
+    for (const Triple& p : pairs)
+      if (places->contains(p.input->truth)) {
+        ++c.place_samples;
+        c.place_input_mean += p.input->error, c.place_fused_mean += p.fused, c.place_settled_mean += p.settled;
+      }
+  if (c.place_samples > 0) {
+    const double m = static_cast<double>(c.place_samples);
+    c.place_input_mean /= m, c.place_fused_mean /= m, c.place_settled_mean /= m;
+  }
   // Stretches by distance along the true path.
   std::size_t begin = 0;
   double along = 0.0;

@@ -21,6 +21,7 @@
 #include "coloc/sim/vehicle_motion.hpp"
 #include "coloc/pipeline/config.hpp"
 #include "coloc/replay/log_replay.hpp"
+#include "coloc/replay/accurate_places.hpp"
 #include "coloc/replay/log_smoother.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
 #include "coloc/twin/twin_recording.hpp"
@@ -134,6 +135,8 @@ struct Job {
   Stamp until = 0;         ///< the replay ends here (0: at the log's end): replay::ReplayOptions::until
   bool keep_ndt_errors = false;  ///< keep NDT's own error per pose: `ndt_errors`
   std::vector<replay::ErrorSample> ndt_errors;
+  /// Where NDT was accurate on the site's noise calibration drive: the filter beside NDT there too.
+  std::shared_ptr<const replay::AccuratePlaces> places;
   std::optional<ExperimentRun> smoothed;
   std::map<std::string, smoother::RsuCalibration> calibrations;  ///< per RSU id, with `calibrate`
   std::optional<rsu_client::RsuRegistry> calibrated;  ///< the registry with the calibrations found
@@ -240,7 +243,13 @@ void runJob(Job& job) {
     r = replay::replayLog(job.log, options);
   }
   fillRun(job.run, r.ground_truth, r.errors, job.rsu_positions);
-  if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) job.run.ndt = c->second;
+  if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) {
+    job.run.ndt = c->second;
+    if (job.places)
+      job.run.ndt = replay::compareWithInput(r.input_errors[pipeline::kNdtSource], r.fused_at_inputs[pipeline::kNdtSource],
+                                             r.settled_at_inputs[pipeline::kNdtSource], c->second.stretch_length, c->second.accurate_below,
+                                             job.places.get());
+  }
   if (job.keep_ndt_errors)
     if (auto e = r.input_errors.find(pipeline::kNdtSource); e != r.input_errors.end()) job.ndt_errors = std::move(e->second);
   const auto fused = [&](const std::string& topic) { return std::find(job.fix_topics.begin(), job.fix_topics.end(), topic) != job.fix_topics.end(); };
@@ -441,6 +450,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<Eigen::Vector2d> twist_variance(config.sites.size(), Eigen::Vector2d::Zero());  // per site: vx, wz
   std::vector<std::optional<Eigen::Vector2d>> ndt_variance(config.sites.size());  // per site: x/y, yaw
   std::vector<std::string> ndt_quality(config.sites.size());  // per site: NDT's error by place (its file)
+  // Per site: where NDT was accurate on the noise calibration drive (by InputComparison's criterion).
+  std::vector<std::shared_ptr<const replay::AccuratePlaces>> accurate_places(config.sites.size());
   std::vector<double> ndt_quality_default(config.sites.size(), 0.0);  // and its mean square over the drive
 
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
@@ -598,6 +609,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.log = rec.out_dir + "/log";
       job.map = maps[drive.site];
       job.cache = cache;
+      job.places = accurate_places[drive.site];
       job.config = fuse;
       job.config.rsu.checks.station_id = scenario.vehicle_station_id;  // the ego takes the fixes addressed to it
       job.rsu_positions = rsu_positions;
@@ -824,6 +836,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (drive.variant == kNoiseCalibrationDrive) {
         ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
         results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
+        // A cell needs about a stretch's scans at the cruise speed to be judged (10 at 10 m/s over 10 m).
+        constexpr std::size_t kPlacePoses = 5;
+        accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(
+            replay::AccuratePlaces::fromErrors(j.ndt_errors, j.run.ndt.stretch_length, j.run.ndt.accurate_below, kPlacePoses));
         if (config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
           const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
           ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();

@@ -409,10 +409,13 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
   {
     struct Pool {
       double n = 0, ndt = 0, fused = 0, settled = 0, acc_n = 0, acc_ndt = 0, acc_fused = 0, acc_settled = 0;
+      double place_n = 0, place_ndt = 0, place_fused = 0, place_settled = 0;
       void add(const replay::InputComparison& k) {
         n += k.samples, ndt += k.input_mean * k.samples, fused += k.fused_mean * k.samples, settled += k.settled_mean * k.samples;
         acc_n += k.accurate_samples, acc_ndt += k.accurate_input_mean * k.accurate_samples;
         acc_fused += k.accurate_fused_mean * k.accurate_samples, acc_settled += k.accurate_settled_mean * k.accurate_samples;
+        place_n += k.place_samples, place_ndt += k.place_input_mean * k.place_samples;
+        place_fused += k.place_fused_mean * k.place_samples, place_settled += k.place_settled_mean * k.place_samples;
       }
     };
     std::map<std::tuple<double, std::string, std::string>, Pool> by;  // (speed, configuration, site or "")
@@ -436,29 +439,40 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     if (!by.empty()) {
       std::ostringstream csv;
       csv << "speed_mps,configuration,site,scans,ndt_mean_m,output_mean_m,settled_mean_m,accurate_scans,accurate_ndt_mean_m,accurate_output_mean_m,"
-             "accurate_settled_mean_m\n";
+             "accurate_settled_mean_m,place_scans,place_ndt_mean_m,place_output_mean_m,place_settled_mean_m\n";
       ndt_md << "NDT's own pose per scan beside the filter at the same stamps, the sites and trials pooled: its output as given out "
                 "then (interpolated between ticks; it cannot know that scan's pose yet, which comes a sweep and a match later), and "
                 "its estimate for the stamp once that scan's pose is in (settled: the same information NDT's pose has, and what came "
                 "before). \"Where NDT is accurate\": the "
              << fmt("%.0f m", stretch) << " stretches of road where NDT's mean error is below " << fmt("%.0f cm", 100 * below)
-             << " (chosen by stretch, not by scan, which would favour NDT by its luck on those scans).\n\n"
-             << "| speed | configuration | NDT per scan | output | settled | scans where NDT is accurate | NDT there | output there | settled there | settled / NDT there |\n"
-                "|---|---|---|---|---|---|---|---|---|---|\n";
+             << " (chosen by stretch, not by scan, which would favour NDT by its luck on those scans). Chosen by this drive's own "
+                "NDT error, a stretch is still chosen for its luck on it, most at speed, where it holds few scans; \"where NDT was "
+                "accurate\" chooses the places (cells of "
+             << fmt("%.0f m", stretch) << ") by the same criterion on the site's noise calibration drive, another drive over the same road.\n\n"
+             << "| speed | configuration | NDT per scan | output | settled | scans where NDT is accurate | NDT there | output there | settled there | settled / NDT there "
+                "| scans where NDT was accurate | NDT there | settled there | settled / NDT there |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       for (const auto& [key, p] : by) {
         const auto& [speed, configuration, site] = key;
         csv << speed << "," << configuration << "," << (site.empty() ? "all" : site) << "," << p.n << "," << p.ndt / p.n << "," << p.fused / p.n << ","
             << p.settled / p.n << "," << p.acc_n << "," << (p.acc_n ? p.acc_ndt / p.acc_n : 0.0) << "," << (p.acc_n ? p.acc_fused / p.acc_n : 0.0) << ","
-            << (p.acc_n ? p.acc_settled / p.acc_n : 0.0) << "\n";
+            << (p.acc_n ? p.acc_settled / p.acc_n : 0.0) << "," << p.place_n << "," << (p.place_n ? p.place_ndt / p.place_n : 0.0) << ","
+            << (p.place_n ? p.place_fused / p.place_n : 0.0) << "," << (p.place_n ? p.place_settled / p.place_n : 0.0) << "\n";
         if (!site.empty()) continue;
         ndt_md << "| " << fmt("%.0f m/s", speed) << " | " << configuration << " | " << fmt("%.2f cm", 100 * p.ndt / p.n) << " | "
                << fmt("%.2f cm", 100 * p.fused / p.n) << " | " << fmt("%.2f cm", 100 * p.settled / p.n) << " | "
                << fmt("%.0f %%", 100 * p.acc_n / p.n) << " | ";
         if (p.acc_n > 0)
           ndt_md << fmt("%.2f cm", 100 * p.acc_ndt / p.acc_n) << " | " << fmt("%.2f cm", 100 * p.acc_fused / p.acc_n) << " | "
-                 << fmt("%.2f cm", 100 * p.acc_settled / p.acc_n) << " | " << fmt("%.2f", p.acc_settled / p.acc_ndt) << " |\n";
+                 << fmt("%.2f cm", 100 * p.acc_settled / p.acc_n) << " | " << fmt("%.2f", p.acc_settled / p.acc_ndt) << " | ";
         else
-          ndt_md << "- | - | - | - |\n";
+          ndt_md << "- | - | - | - | ";
+        ndt_md << fmt("%.0f %%", 100 * p.place_n / p.n) << " | ";
+        if (p.place_n > 0)
+          ndt_md << fmt("%.2f cm", 100 * p.place_ndt / p.place_n) << " | " << fmt("%.2f cm", 100 * p.place_settled / p.place_n) << " | "
+                 << fmt("%.2f", p.place_settled / p.place_ndt) << " |\n";
+        else
+          ndt_md << "- | - | - |\n";
       }
       writeFile(out_dir + "/ndt_vs_fused.csv", csv.str());
     }

@@ -3,6 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
+
+#include "coloc/core/error.hpp"
+#include "coloc/replay/accurate_places.hpp"
 
 namespace coloc::replay {
 namespace {
@@ -82,6 +87,61 @@ TEST(Evaluation, InputComparisonWithNothingInCommonIsEmpty) {
   const InputComparison c = compareWithInput({sampleAt(0.0, 0.01)}, {sampleAt(0.5, 0.01)}, {sampleAt(0.0, 0.01)}, 10.0, 0.02);
   EXPECT_EQ(c.samples, 0u);
   EXPECT_EQ(c.accurate_samples, 0u);
+}
+
+
+// The places come from a reference drive: on it NDT errs 1 cm over the first 20 m and 5 cm beyond. On
+// the drive compared it happens to err 3 cm over the first 20 m and 1 cm beyond: its own stretches
+// choose the last 20 m for that luck, the reference's places the first 20 m, where the road holds NDT.
+TEST(AccuratePlaces, ChoosesThePlacesOnAReferenceDriveNotByTheComparedDrivesLuck) {
+  std::vector<ErrorSample> reference, input, fused, settled;
+  for (int k = 0; k < 40; ++k) {
+    const double t = 0.1 * k;  // 10 m/s: a pose a metre
+    reference.push_back(sampleAt(t, k < 20 ? 0.01 : 0.05));
+    input.push_back(sampleAt(t, k < 20 ? 0.03 : 0.01));
+    fused.push_back(sampleAt(t, 0.02));
+    settled.push_back(sampleAt(t, k < 20 ? 0.025 : 0.015));
+  }
+  const AccuratePlaces places = AccuratePlaces::fromErrors(reference, 10.0, 0.02, 5);
+  EXPECT_EQ(places.judged(), 4u);
+  EXPECT_EQ(places.accurate(), 2u);
+  EXPECT_TRUE(places.contains({0.0, 0.0}));
+  EXPECT_TRUE(places.contains({19.9, 9.9}));  // the cell is square: beside the road too
+  EXPECT_FALSE(places.contains({20.0, 0.0}));
+  EXPECT_FALSE(places.contains({-0.1, 0.0}));  // never driven: not judged, not accurate
+  EXPECT_FALSE(places.contains({std::nan(""), 0.0}));
+  const InputComparison c = compareWithInput(input, fused, settled, 10.0, 0.02, &places);
+  EXPECT_EQ(c.accurate_samples, 20u);  // its own stretches: the lucky last 20 m
+  EXPECT_NEAR(c.accurate_input_mean, 0.01, 1e-12);
+  EXPECT_EQ(c.place_samples, 20u);  // the reference's places: the first 20 m
+  EXPECT_NEAR(c.place_input_mean, 0.03, 1e-12);
+  EXPECT_NEAR(c.place_fused_mean, 0.02, 1e-12);
+  EXPECT_NEAR(c.place_settled_mean, 0.025, 1e-12);
+  // Without places, none.
+  EXPECT_EQ(compareWithInput(input, fused, settled, 10.0, 0.02).place_samples, 0u);
+}
+
+TEST(AccuratePlaces, ACellWithTooFewPosesOrNoNumberIsNotJudgedAndBadSettingsAreNamed) {
+  std::vector<ErrorSample> reference;
+  for (int k = 0; k < 4; ++k) reference.push_back(sampleAt(0.1 * k, 0.01));  // 4 poses in the first cell
+  ErrorSample lost = sampleAt(0.0, 0.01);
+  lost.truth.x() = std::nan("");
+  reference.push_back(lost);
+  reference.push_back(sampleAt(0.05, std::numeric_limits<double>::infinity()));
+  EXPECT_EQ(AccuratePlaces::fromErrors(reference, 10.0, 0.02, 5).judged(), 0u);
+  EXPECT_EQ(AccuratePlaces::fromErrors(reference, 10.0, 0.02, 4).accurate(), 1u);
+  const auto message = [&](double cell, double below) {
+    try {
+      AccuratePlaces::fromErrors(reference, cell, below, 5);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message(std::nan(""), 0.02).find("cell"), std::string::npos);
+  EXPECT_NE(message(0.0, 0.02).find("cell"), std::string::npos);
+  EXPECT_NE(message(10.0, -0.02).find("below"), std::string::npos);
+  EXPECT_NE(message(10.0, std::numeric_limits<double>::infinity()).find("below"), std::string::npos);
 }
 
 }  // namespace

@@ -63,6 +63,10 @@ struct InputComparison {
   double accurate_below = 0.0;            ///< m: a stretch where the input's mean error is below this is "accurate"
   std::size_t accurate_samples = 0;       ///< input poses in such stretches
   double accurate_input_mean = 0.0, accurate_fused_mean = 0.0, accurate_settled_mean = 0.0;  ///< m, over those
+  /// The same where the source was accurate on a reference drive (AccuratePlaces, by true position;
+  /// 0 when none was given).
+  std::size_t place_samples = 0;
+  double place_input_mean = 0.0, place_fused_mean = 0.0, place_settled_mean = 0.0;  ///< m
   /// The input's error per axis, what a reference drive measures for a source's fixed covariance: the
   /// mean square of x and y (m^2, pooled; biases included: a map's error is the source's error) and
   /// the variance of yaw about its mean (rad^2; the mean is the LiDAR's mounting yaw, which the
@@ -76,8 +80,12 @@ struct InputComparison {
 /// elsewhere the drive's own mean square (x and y pooled). What ndt.quality_map reads.
 pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, double cell = 10.0, std::size_t min_poses = 5);
 
-/// The three pair by stamp (a stamp missing from any of them is left out).
+class AccuratePlaces;
+
+/// The three pair by stamp (a stamp missing from any of them is left out). With `places`, the
+/// place_* figures too.
 InputComparison compareWithInput(const std::vector<ErrorSample>& input, const std::vector<ErrorSample>& fused_at_input,
-                                 const std::vector<ErrorSample>& settled_at_input, double stretch_length, double accurate_below);
+                                 const std::vector<ErrorSample>& settled_at_input, double stretch_length, double accurate_below,
+                                 const AccuratePlaces* places = nullptr);
 
 }  // namespace coloc::replay
