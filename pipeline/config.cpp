@@ -376,6 +376,10 @@ const std::vector<Key>& keys() {
        [](const R& r, const N& n, const S& k, C& c) {
          c.replay.input_accurate_below = r.inRange(n, k, 0.0, 1e3);
          if (c.replay.input_accurate_below == 0.0) r.fail(n, k, "must be > 0"); }},
+      {"replay", "input_reference", "",
+       "an input_error.csv coloc fuse wrote for a reference drive over the same roads (relative to this file): each input also compared where it was accurate on that drive; null = none",
+       [](const C& c) { return quoted(c.replay.input_reference); },
+       [](const R& r, const N& n, const S& k, C& c) { c.replay.input_reference = n.IsNull() ? S() : r.text(n, k); }},
       // ---- smoother
       {"smoother", "estimate_noise", "", "measure each source's noise on the drive instead of taking the messages' covariances as given",
        [](const C& c) { return S(c.smoother.estimate_noise ? "true" : "false"); },
@@ -536,6 +540,8 @@ Config loadConfig(const std::string& path) {
     config.rsu.registry = (fs::path(path).parent_path() / config.rsu.registry).lexically_normal().string();
   if (!config.ndt.quality_map.empty() && fs::path(config.ndt.quality_map).is_relative())
     config.ndt.quality_map = (fs::path(path).parent_path() / config.ndt.quality_map).lexically_normal().string();
+  if (!config.replay.input_reference.empty() && fs::path(config.replay.input_reference).is_relative())
+    config.replay.input_reference = (fs::path(path).parent_path() / config.replay.input_reference).lexically_normal().string();
   return config;
 }
 

@@ -1,6 +1,10 @@
 #include "coloc/replay/accurate_places.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "coloc/core/error.hpp"
@@ -24,6 +28,51 @@ AccuratePlaces AccuratePlaces::fromErrors(const std::vector<ErrorSample>& errors
   for (const auto& [key, s] : sums)
     if (s.second >= std::max<std::size_t>(1, min_samples)) p.judged_[key] = s.first / static_cast<double>(s.second) < below;
   return p;
+}
+
+std::map<std::string, AccuratePlaces> AccuratePlaces::fromInputErrorCsv(const std::string& path, double cell, double below, std::size_t min_samples) {
+  fromErrors({}, cell, below, min_samples);  // the settings checked before the file, which may hold no pose
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot be read (an input_error.csv of a reference drive)");
+  const auto split = [](const std::string& line) {
+    std::vector<std::string> fields;
+    std::stringstream text(line);
+    for (std::string f; std::getline(text, f, ',');) fields.push_back(f);
+    if (!line.empty() && line.back() == ',') fields.emplace_back();
+    return fields;
+  };
+  std::string line;
+  if (!std::getline(in, line)) throw Error(path + ": empty, not an input_error.csv");
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const std::vector<std::string> header = split(line);
+  const auto column = [&](const char* name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    if (at == header.end()) throw Error(path + ": no column " + name + " (an input_error.csv that coloc fuse writes has source, truth_x, truth_y, error_m)");
+    return static_cast<std::size_t>(at - header.begin());
+  };
+  const std::size_t source = column("source"), x = column("truth_x"), y = column("truth_y"), error = column("error_m");
+  std::map<std::string, std::vector<ErrorSample>> samples;
+  for (std::size_t number = 2; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::vector<std::string> fields = split(line);
+    if (fields.size() != header.size())
+      throw Error(path + ":" + std::to_string(number) + ": " + std::to_string(fields.size()) + " fields, the header has " + std::to_string(header.size()));
+    const auto number_in = [&](std::size_t c) {
+      const std::string& f = fields[c];
+      char* end = nullptr;
+      const double v = std::strtod(f.c_str(), &end);
+      if (f.empty() || end != f.c_str() + f.size()) throw Error(path + ":" + std::to_string(number) + ": " + header[c] + ": '" + f + "' is not a number");
+      return v;
+    };
+    ErrorSample e{};
+    e.truth = Eigen::Vector2d(number_in(x), number_in(y));
+    e.error = number_in(error);
+    samples[fields[source]].push_back(e);
+  }
+  std::map<std::string, AccuratePlaces> out;
+  for (const auto& [name, errors] : samples) out[name] = fromErrors(errors, cell, below, min_samples);
+  return out;
 }
 
 AccuratePlaces::Key AccuratePlaces::keyOf(const Eigen::Vector2d& xy) const {

@@ -63,6 +63,7 @@ InputComparison compareWithInput(const std::vector<ErrorSample>& input, const st
   InputComparison c;
   c.stretch_length = stretch_length;
   c.accurate_below = accurate_below;
+  c.places_given = places != nullptr;
   // Pair by stamp; all three are in stamp order.
   struct Triple {
     const ErrorSample* input;

@@ -13,6 +13,7 @@
 #include "coloc/io/ros_messages.hpp"
 #include "coloc/pipeline/message_inputs.hpp"
 #include "coloc/pipeline/static_transforms.hpp"
+#include "coloc/replay/accurate_places.hpp"
 #include "coloc/rsu_client/link_emulator.hpp"
 
 namespace coloc::replay {
@@ -317,12 +318,17 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
   const pipeline::Config& config = options.config;
   std::optional<rsu_client::RsuRegistry> registry = options.registry;
   if (!registry && !config.rsu.registry.empty()) registry = rsu_client::RsuRegistry::load(config.rsu.registry);
+  // The reference drive's places, read before the replay: a bad file stops it before it has cost anything.
+  std::map<std::string, AccuratePlaces> reference_places;
+  if (!config.replay.input_reference.empty())
+    reference_places = AccuratePlaces::fromInputErrorCsv(config.replay.input_reference, config.replay.input_stretch_length, config.replay.input_accurate_below);
   std::optional<io::BagReader> bag;
   std::shared_ptr<const RecordedLog> recorded;
   if (options.cache) recorded = options.cache->log(log_path);
   else bag.emplace(io::BagReader::open(log_path, io::BagReadOptions{options.recover}));
   const std::vector<io::TopicInfo>& log_topics = recorded ? recorded->topics() : bag->topics();
   ReplayResult result;
+  result.input_reference = config.replay.input_reference;
   if (bag) result.recovered = bag->recovered();
   result.topics = planTopics(log_topics, config, !options.map.empty(), registry ? &*registry : nullptr, result.rejections);
   const bool has_input = std::any_of(result.topics.begin(), result.topics.end(), [](const TopicUse& t) {
@@ -378,8 +384,10 @@ ReplayResult replayLog(const std::string& log_path, const ReplayOptions& options
       std::vector<io::TrajectoryPoint>& settled = result.settled_poses[source];
       std::sort(settled.begin(), settled.end(), [](const io::TrajectoryPoint& a, const io::TrajectoryPoint& b) { return a.stamp < b.stamp; });
       result.settled_at_inputs[source] = evaluate(settled, result.ground_truth, max_gap);
+      const auto reference = reference_places.find(source);
       result.input_comparison[source] = compareWithInput(result.input_errors[source], result.fused_at_inputs[source], result.settled_at_inputs[source],
-                                                         config.replay.input_stretch_length, config.replay.input_accurate_below);
+                                                         config.replay.input_stretch_length, config.replay.input_accurate_below,
+                                                         reference == reference_places.end() ? nullptr : &reference->second);
     }
   }
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

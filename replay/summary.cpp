@@ -61,6 +61,10 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
       inputs[source]["where_accurate"] = {{"stretch_m", k.stretch_length}, {"input_mean_below_m", k.accurate_below},
                                           {"samples", k.accurate_samples}, {"input_mean_m", k.accurate_input_mean},
                                           {"fused_mean_m", k.accurate_fused_mean}, {"settled_mean_m", k.accurate_settled_mean}};
+      if (k.places_given)
+        inputs[source]["where_accurate_on_reference"] = {{"file", input_reference}, {"cell_m", k.stretch_length}, {"input_mean_below_m", k.accurate_below},
+                                                         {"samples", k.place_samples}, {"input_mean_m", k.place_input_mean},
+                                                         {"fused_mean_m", k.place_fused_mean}, {"settled_mean_m", k.place_settled_mean}};
       inputs[source]["covariance_estimate"] = {{"xy_mean_square_m2", k.mean_square_xy}, {"yaw_variance_rad2", k.yaw_variance},
                                                {"yaw_mean_rad", k.yaw_mean}};
     }

@@ -109,6 +109,18 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
       const ErrorStats i = errorStats(samples);
       std::printf("  %-22s its own poses (%zu): mean %.4f m, RMSE %.4f m; bias %+.4f m along, %+.4f m across\n", source.c_str(),
                   samples.size(), i.mean, i.rmse, i.along_mean, i.across_mean);
+      // The filter's settled estimate beside it where it is accurate: on this drive's stretches, and
+      // on the reference drive's places (replay.input_reference), which carry no luck of this drive.
+      const auto c = r.input_comparison.find(source);
+      if (c == r.input_comparison.end()) continue;
+      const InputComparison& k = c->second;
+      if (k.accurate_samples > 0)
+        std::printf("  %-22s where it is accurate (%zu poses on %.0f m stretches under %.2f m): its own %.4f m, the filter's settled %.4f m (%.3fx)\n", "",
+                    k.accurate_samples, k.stretch_length, k.accurate_below, k.accurate_input_mean, k.accurate_settled_mean,
+                    k.accurate_settled_mean / k.accurate_input_mean);
+      if (k.places_given)
+        std::printf("  %-22s where it was accurate on the reference drive (%zu poses): its own %.4f m, the filter's settled %.4f m (%.3fx)\n", "",
+                    k.place_samples, k.place_input_mean, k.place_settled_mean, k.place_samples ? k.place_settled_mean / k.place_input_mean : 0.0);
     }
   } else {
     std::printf("\n  no ground truth in the log: no error figures\n");

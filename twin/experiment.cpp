@@ -136,7 +136,10 @@ struct Job {
   bool keep_ndt_errors = false;  ///< keep NDT's own error per pose: `ndt_errors`
   std::vector<replay::ErrorSample> ndt_errors;
   /// Where NDT was accurate on the site's noise calibration drive: the filter beside NDT there too.
+  /// With the drives recorded, the replay reads them from that drive's input_error.csv instead
+  /// (config.replay.input_reference), as `coloc fuse` of the written configuration does.
   std::shared_ptr<const replay::AccuratePlaces> places;
+  std::string input_error_csv;  ///< write the replay's input_error.csv here (the recorded noise calibration drive's)
   std::optional<ExperimentRun> smoothed;
   std::map<std::string, smoother::RsuCalibration> calibrations;  ///< per RSU id, with `calibrate`
   std::optional<rsu_client::RsuRegistry> calibrated;  ///< the registry with the calibrations found
@@ -245,11 +248,12 @@ void runJob(Job& job) {
   fillRun(job.run, r.ground_truth, r.errors, job.rsu_positions);
   if (const auto c = r.input_comparison.find(pipeline::kNdtSource); c != r.input_comparison.end()) {
     job.run.ndt = c->second;
-    if (job.places)
+    if (job.places && !c->second.places_given)
       job.run.ndt = replay::compareWithInput(r.input_errors[pipeline::kNdtSource], r.fused_at_inputs[pipeline::kNdtSource],
                                              r.settled_at_inputs[pipeline::kNdtSource], c->second.stretch_length, c->second.accurate_below,
                                              job.places.get());
   }
+  if (!job.input_error_csv.empty()) r.writeInputErrorCsv(job.input_error_csv);
   if (job.keep_ndt_errors)
     if (auto e = r.input_errors.find(pipeline::kNdtSource); e != r.input_errors.end()) job.ndt_errors = std::move(e->second);
   const auto fused = [&](const std::string& topic) { return std::find(job.fix_topics.begin(), job.fix_topics.end(), topic) != job.fix_topics.end(); };
@@ -452,6 +456,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<std::string> ndt_quality(config.sites.size());  // per site: NDT's error by place (its file)
   // Per site: where NDT was accurate on the noise calibration drive (by InputComparison's criterion).
   std::vector<std::shared_ptr<const replay::AccuratePlaces>> accurate_places(config.sites.size());
+  std::vector<std::string> reference_errors(config.sites.size());  // per site, recorded: that drive's input_error.csv
   std::vector<double> ndt_quality_default(config.sites.size(), 0.0);  // and its mean square over the drive
 
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
@@ -611,6 +616,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       job.cache = cache;
       job.places = accurate_places[drive.site];
       job.config = fuse;
+      if (job.places && config.recordings) job.config.replay.input_reference = reference_errors[drive.site];
       job.config.rsu.checks.station_id = scenario.vehicle_station_id;  // the ego takes the fixes addressed to it
       job.rsu_positions = rsu_positions;
       if (const auto& v = ndt_variance[drive.site]) {
@@ -689,6 +695,10 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (config.ndt_covariance != NdtCovarianceSource::kPublished) {
         jobs.push_back(makeJob("", 0.0, 0.0, variant, main_covariance));
         jobs.back().keep_ndt_errors = true;  // NDT's error by place
+        if (config.recordings) {
+          reference_errors[drive.site] = fs::absolute(rec.out_dir + "/input_error.csv").lexically_normal().string();
+          jobs.back().input_error_csv = reference_errors[drive.site];
+        }
       }
       for (const sim::ScenarioRsu& r : scenario.rsus)
         if (const auto f = summary.rsu_frames.find(r.id); f != summary.rsu_frames.end()) results.ideal_comparison[reportKey(scenario, r)] = f->second;
@@ -836,10 +846,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (drive.variant == kNoiseCalibrationDrive) {
         ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
         results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
-        // A cell needs about a stretch's scans at the cruise speed to be judged (10 at 10 m/s over 10 m).
-        constexpr std::size_t kPlacePoses = 5;
-        accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(
-            replay::AccuratePlaces::fromErrors(j.ndt_errors, j.run.ndt.stretch_length, j.run.ndt.accurate_below, kPlacePoses));
+        accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(replay::AccuratePlaces::fromErrors(
+            j.ndt_errors, j.run.ndt.stretch_length, j.run.ndt.accurate_below, replay::AccuratePlaces::kMinPoses));
         if (config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
           const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
           ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();

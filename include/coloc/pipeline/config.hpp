@@ -55,6 +55,11 @@ struct ReplayConfig {
   /// stretches of road this long where the input's mean error is below `input_accurate_below`.
   double input_stretch_length = 10.0;  ///< m
   double input_accurate_below = 0.02;  ///< m
+  /// An input_error.csv that `coloc fuse` wrote for a reference drive over the same roads (relative to
+  /// the config file): each input is also compared where it was accurate on that drive (cells of
+  /// input_stretch_length, by the same input_accurate_below), which carries no luck of this drive.
+  /// Empty: not.
+  std::string input_reference;
 };
 
 /// Scan matching of a PointCloud2 topic against a map (`--map`).

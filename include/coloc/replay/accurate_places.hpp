@@ -7,6 +7,7 @@
 // drive compared: the same criterion, the mean planar error over a place, measured independently.
 #include <cstddef>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -16,6 +17,9 @@ namespace coloc::replay {
 
 class AccuratePlaces {
  public:
+  /// Poses a cell needs to be judged: half a 10 m stretch's at 10 m/s and 10 Hz.
+  static constexpr std::size_t kMinPoses = 5;
+
   /// No place: nothing is accurate.
   AccuratePlaces() = default;
 
@@ -24,6 +28,13 @@ class AccuratePlaces {
   /// that are not finite are left out. Throws coloc::Error naming `cell` or `below` unless each is
   /// finite and > 0.
   static AccuratePlaces fromErrors(const std::vector<ErrorSample>& errors, double cell, double below, std::size_t min_samples);
+
+  /// Each source's places from the `input_error.csv` that `coloc fuse` wrote for a reference drive
+  /// (ReplayResult::writeInputErrorCsv; its columns source, truth_x, truth_y and error_m). Throws
+  /// coloc::Error naming the file (and its line and column) if it cannot be read, lacks a column or
+  /// holds a field that is not a number.
+  static std::map<std::string, AccuratePlaces> fromInputErrorCsv(const std::string& path, double cell, double below,
+                                                                 std::size_t min_samples = kMinPoses);
 
   /// Whether the true position `xy` lies in an accurate place.
   bool contains(const Eigen::Vector2d& xy) const;

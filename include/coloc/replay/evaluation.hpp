@@ -65,6 +65,7 @@ struct InputComparison {
   double accurate_input_mean = 0.0, accurate_fused_mean = 0.0, accurate_settled_mean = 0.0;  ///< m, over those
   /// The same where the source was accurate on a reference drive (AccuratePlaces, by true position;
   /// 0 when none was given).
+  bool places_given = false;
   std::size_t place_samples = 0;
   double place_input_mean = 0.0, place_fused_mean = 0.0, place_settled_mean = 0.0;  ///< m
   /// The input's error per axis, what a reference drive measures for a source's fixed covariance: the

@@ -52,6 +52,7 @@ struct ReplayResult {
   std::map<std::string, std::vector<ErrorSample>> fused_at_inputs, settled_at_inputs;
   std::map<std::string, std::vector<io::TrajectoryPoint>> settled_poses;  ///< by source, as the pipeline gave them
   std::map<std::string, InputComparison> input_comparison;
+  std::string input_reference;  ///< the reference drive's input_error.csv the comparison's places came from (replay.input_reference)
   std::vector<io::TrajectoryPoint> ground_truth;
   std::vector<ErrorSample> errors;                 ///< at ticks with ground truth
   ClockMode clock = ClockMode::kAuto;              ///< the mode used (never kAuto)
