@@ -8,12 +8,13 @@
 #include <string>
 
 #include "coloc/core/error.hpp"
+#include "coloc/core/number_text.hpp"
 
 namespace coloc::replay {
 
 AccuratePlaces AccuratePlaces::fromErrors(const std::vector<ErrorSample>& errors, double cell, double below, std::size_t min_samples) {
-  if (!(std::isfinite(cell) && cell > 0.0)) throw Error("accurate places: cell must be a finite number of metres > 0, not " + std::to_string(cell));
-  if (!(std::isfinite(below) && below > 0.0)) throw Error("accurate places: below must be a finite number of metres > 0, not " + std::to_string(below));
+  if (!(std::isfinite(cell) && cell > 0.0)) throw Error("accurate places: cell must be a finite number of metres > 0, not " + exactNumberText(cell));
+  if (!(std::isfinite(below) && below > 0.0)) throw Error("accurate places: below must be a finite number of metres > 0, not " + exactNumberText(below));
   AccuratePlaces p;
   p.cell_ = cell;
   p.below_ = below;
@@ -62,7 +63,10 @@ std::map<std::string, AccuratePlaces> AccuratePlaces::fromInputErrorCsv(const st
       const std::string& f = fields[c];
       char* end = nullptr;
       const double v = std::strtod(f.c_str(), &end);
-      if (f.empty() || end != f.c_str() + f.size()) throw Error(path + ":" + std::to_string(number) + ": " + header[c] + ": '" + f + "' is not a number");
+      // coloc fuse writes each of these as a finite number (an error as a distance): anything else is not its file.
+      if (f.empty() || end != f.c_str() + f.size() || !std::isfinite(v))
+        throw Error(path + ":" + std::to_string(number) + ": " + header[c] + ": '" + f + "' is not a finite number");
+      if (c == error && v < 0.0) throw Error(path + ":" + std::to_string(number) + ": error_m: " + f + " is negative; an error is a distance");
       return v;
     };
     ErrorSample e{};

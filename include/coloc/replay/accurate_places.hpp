@@ -31,8 +31,8 @@ class AccuratePlaces {
 
   /// Each source's places from the `input_error.csv` that `coloc fuse` wrote for a reference drive
   /// (ReplayResult::writeInputErrorCsv; its columns source, truth_x, truth_y and error_m). Throws
-  /// coloc::Error naming the file (and its line and column) if it cannot be read, lacks a column or
-  /// holds a field that is not a number.
+  /// coloc::Error naming the file (and its line and column) if it cannot be read, lacks a column, has a
+  /// row of another width or holds a field that is not a finite number (or an error_m below 0).
   static std::map<std::string, AccuratePlaces> fromInputErrorCsv(const std::string& path, double cell, double below,
                                                                  std::size_t min_samples = kMinPoses);
 
