@@ -275,11 +275,21 @@ void runJob(Job& job) {
 
 // Runs the jobs side by side; the first error stops the rest and is rethrown.
 void runJobs(std::vector<Job>& jobs, int threads) {
+  // The longest first (a smoothed replay, then a whole one, then one that ends with the coverage): the
+  // last to finish is then a short one, and the threads end together. Each job is computed alone, so
+  // the order changes no result (the tables the same to the digit). On the quick run the time one
+  // thread waited for the other at the drives' ends went 3.0 -> 0.6 s (of 33 s of replays); on the full
+  // run 26.4 -> 24.3 s (of 410 s), where most of it is drives of two or three replays alike.
+  std::vector<std::size_t> order(jobs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto weight = [](const Job& j) { return (j.smooth || j.calibrate ? 2 : 0) + (j.until == 0 ? 1 : 0); };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return weight(jobs[a]) > weight(jobs[b]); });
   std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
   std::mutex mutex;
   auto worker = [&] {
-    for (std::size_t i; (i = next++) < jobs.size();) {
+    for (std::size_t k; (k = next++) < jobs.size();) {
+      const std::size_t i = order[k];
       try {
         runJob(jobs[i]);
       } catch (...) {
