@@ -19,24 +19,50 @@ std::pair<long long, long long> NdtQualityMap::indexOf(const Eigen::Vector2d& xy
   return {static_cast<long long>(std::floor(xy.x() / cell_)), static_cast<long long>(std::floor(xy.y() / cell_))};
 }
 
+std::vector<bool> NdtQualityMap::grossErrors(const std::vector<NdtQualitySample>& samples, double cell) {
+  if (!(cell >= kMinCell && cell <= kMaxCell)) throw Error("NDT quality map: the cell must be " + std::to_string(kMinCell) + "-" + std::to_string(kMaxCell) + " m");
+  NdtQualityMap map;
+  map.cell_ = cell;
+  std::map<std::pair<long long, long long>, std::vector<std::size_t>> members;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const NdtQualitySample& s = samples[i];
+    if (!s.position.allFinite() || !s.error.allFinite() || s.position.cwiseAbs().maxCoeff() > kMaxCoordinate)
+      throw Error("NDT quality map: sample " + std::to_string(i) + " is not finite or lies beyond 1e9 m");
+    members[map.indexOf(s.position)].push_back(i);
+  }
+  std::vector<bool> gross(samples.size(), false);
+  std::vector<double> errors;
+  for (const auto& [index, in] : members) {
+    if (in.size() < 3) continue;  // no median to speak of
+    errors.clear();
+    for (std::size_t i : in) errors.push_back(samples[i].error.norm());
+    std::sort(errors.begin(), errors.end());
+    const std::size_t n = errors.size();
+    const double median = n % 2 ? errors[n / 2] : 0.5 * (errors[n / 2 - 1] + errors[n / 2]);
+    for (std::size_t i : in) gross[i] = samples[i].error.norm() > kGrossError * median;
+  }
+  return gross;
+}
+
 NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples, double default_variance) {
   if (!(cell >= kMinCell && cell <= kMaxCell)) throw Error("NDT quality map: the cell must be " + std::to_string(kMinCell) + "-" + std::to_string(kMaxCell) + " m");
   if (!(default_variance >= 0.0 && default_variance <= kMaxVariance)) throw Error("NDT quality map: the default variance must be a finite number of m^2 >= 0");
+  const std::vector<bool> gross = grossErrors(samples, cell);
   NdtQualityMap map;
   map.cell_ = cell;
   map.default_variance_ = default_variance;
+  map.gross_left_out_ = static_cast<std::size_t>(std::count(gross.begin(), gross.end(), true));
   std::map<std::pair<long long, long long>, std::pair<double, std::size_t>> sums;
   double change = 0.0;
   std::size_t changes = 0;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const NdtQualitySample& s = samples[i];
-    if (!s.position.allFinite() || !s.error.allFinite() || s.position.cwiseAbs().maxCoeff() > kMaxCoordinate)
-      throw Error("NDT quality map: sample " + std::to_string(i) + " is not finite or lies beyond 1e9 m");
+    if (gross[i]) continue;
     auto& sum = sums[map.indexOf(s.position)];
     sum.first += 0.5 * s.error.squaredNorm();  // x and y pooled
     ++sum.second;
     // Two independent draws of the noise differ by twice its variance, per axis; x and y pooled.
-    if (i > 0 && (s.position - samples[i - 1].position).norm() < cell) {
+    if (i > 0 && !gross[i - 1] && (s.position - samples[i - 1].position).norm() < cell) {
       change += 0.25 * (s.error - samples[i - 1].error).squaredNorm();
       ++changes;
     }
@@ -60,7 +86,10 @@ std::string NdtQualityMap::toYaml() const {
       << "# Each NDT pose's x/y variance is held at least at its cell's (ndt.quality_map).\n"
       << "cell: " << cell_ << "  # m; cell [i, j] spans x in [i, i + 1) * cell, y in [j, j + 1) * cell\n"
       << "default_variance: " << default_variance_ << "  # m^2, where no cell is listed\n"
-      << "noise_variance: " << noise_variance_ << "  # m^2 per axis: NDT's scan-to-scan noise (half the mean square change between consecutive poses)\n"
+      << "noise_variance: " << noise_variance_ << "  # m^2 per axis: NDT's scan-to-scan noise (half the mean square change between consecutive poses)\n";
+  if (gross_left_out_ > 0)
+    out << "# " << gross_left_out_ << " pose(s) left out as gross errors (over " << kGrossError << "x their cell's median error): the travel check's to catch, not the place's\n";
+  out
       << "cells:  # [i, j, poses, variance]\n";
   if (cells_.empty()) out << "  []\n";
   for (const auto& [index, c] : cells_) out << "  - [" << index.first << ", " << index.second << ", " << c.samples << ", " << c.variance << "]\n";

@@ -148,15 +148,19 @@ ErrorStats errorStats(const std::vector<ErrorSample>& errors) {
 pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, double cell, std::size_t min_poses) {
   std::vector<pipeline::NdtQualitySample> samples;
   samples.reserve(ndt.size());
-  double sum = 0.0;
   for (const ErrorSample& s : ndt) {
     // A sample the map cannot place (not finite, or beyond the 1e9 m it indexes) says nothing about any place: left out, not an error
     // that would stop `coloc fuse` after its replay.
     if (!s.estimate.allFinite() || !s.truth.allFinite() || s.estimate.cwiseAbs().maxCoeff() > 1e9) continue;
     samples.push_back({s.estimate, s.estimate - s.truth});
-    sum += 0.5 * samples.back().error.squaredNorm();
   }
-  return pipeline::NdtQualityMap::fromErrors(samples, cell, min_poses, samples.empty() ? 0.0 : sum / static_cast<double>(samples.size()));
+  // The drive's own figure, for places without a cell, leaves the gross errors out as the cells do.
+  const std::vector<bool> gross = pipeline::NdtQualityMap::grossErrors(samples, cell);
+  double sum = 0.0;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    if (!gross[i]) sum += 0.5 * samples[i].error.squaredNorm(), ++kept;
+  return pipeline::NdtQualityMap::fromErrors(samples, cell, min_poses, kept ? sum / static_cast<double>(kept) : 0.0);
 }
 
 }  // namespace coloc::replay

@@ -158,6 +158,8 @@ void writeReplayConfig(const Job& job, const std::string& dir) {
   // As coloc fuse reads it: relative to the configuration's folder.
   if (!config.ndt.quality_map.empty())
     config.ndt.quality_map = fs::relative(fs::absolute(config.ndt.quality_map), fs::absolute(dir)).string();
+  if (!config.replay.input_reference.empty())
+    config.replay.input_reference = fs::relative(fs::absolute(config.replay.input_reference), fs::absolute(dir)).string();
   // Its figures all lie within coverage: the experiment ended the replay there (the same figures).
   const std::string ended = job.until ? "# (the experiment ended it at stamp " + formatSeconds(job.until) + ", past the RSUs' coverage)\n" : std::string();
   std::ofstream(dir + "/" + name + ".yaml") << pipeline::configYaml(

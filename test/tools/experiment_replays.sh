@@ -42,7 +42,7 @@ awk -v a="$mean" -v b="$expected_mean" 'BEGIN { d = a - b; if (d < 0) d = -d; ex
 # NDT beside the filter where it was accurate on the noise calibration drive: the configuration names
 # that drive's input_error.csv, kept beside its log, and coloc fuse compares on its places.
 reference=$(sed -n 's/^ *input_reference: *"\{0,1\}\([^"]*\)"\{0,1\}$/\1/p' "$file")
-[ "$reference" = "$work/out/recordings/small_site/noise_calibration_drive/input_error.csv" ] && [ -s "$reference" ] ||
+[ "$reference" = "../../noise_calibration_drive/input_error.csv" ] && [ -s "$(dirname "$file")/$reference" ] ||
   { echo "FAIL: the replay's configuration names '$reference' as the reference drive's errors"; exit 1; }
 grep -q '"where_accurate_on_reference"' "$work/fuse/summary.json" || { echo "FAIL: coloc fuse did not compare on the reference's places"; exit 1; }
 echo "coloc fuse with the written configuration gave the experiment's replay"
