@@ -148,6 +148,7 @@ TEST(AccuratePlaces, ACellWithTooFewPosesOrNoNumberIsNotJudgedAndBadSettingsAreN
 }  // namespace coloc::replay
 
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "coloc/replay/log_replay.hpp"
@@ -248,6 +249,44 @@ TEST(Evaluation, InputErrorCsvPutsTheFiltersOutputAndSettledEstimateBesideEachIn
 // NDT's error by place from its poses on a drive: each at NDT's own position with its x/y error; a
 // pose that is not finite places nothing and is left out, and the drive's own mean square answers
 // where no cell has enough poses.
+// The reference drive's places from the input_error.csv a replay writes: each source its own, the
+// same as from its errors in memory; a file that is not such a file is refused by line and column.
+TEST(AccuratePlaces, TheReferenceDrivesInputErrorCsvGivesEachSourceItsPlaces) {
+  ReplayResult r;
+  for (int k = 0; k < 40; ++k) {  // ndt 1 cm off over the first 20 m, 5 cm beyond; a fix 1 cm everywhere
+    r.input_errors["ndt"].push_back(sampleAt(0.1 * k, k < 20 ? 0.01 : 0.05));
+    r.input_errors["/rsu/a/fix"].push_back(sampleAt(0.1 * k, 0.01));
+  }
+  testing::TempDir dir;
+  r.writeInputErrorCsv(dir / "input_error.csv");
+  const std::map<std::string, AccuratePlaces> read = AccuratePlaces::fromInputErrorCsv(dir / "input_error.csv", 10.0, 0.02);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read.at("ndt").accurate(), 2u);
+  EXPECT_EQ(read.at("ndt").judged(), 4u);
+  EXPECT_EQ(read.at("/rsu/a/fix").accurate(), 4u);
+  const AccuratePlaces memory = AccuratePlaces::fromErrors(r.input_errors["ndt"], 10.0, 0.02, AccuratePlaces::kMinPoses);
+  for (double x = 0.5; x < 40.0; x += 1.0) EXPECT_EQ(read.at("ndt").contains({x, 0.0}), memory.contains({x, 0.0})) << x;
+  // Not such a file.
+  const auto refusal = [&](const std::string& text) {
+    std::ofstream(dir / "bad.csv") << text;
+    try {
+      AccuratePlaces::fromInputErrorCsv(dir / "bad.csv", 10.0, 0.02);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("taken");
+  };
+  EXPECT_NE(refusal("").find("empty"), std::string::npos);
+  EXPECT_NE(refusal("source,truth_x,error_m\n").find("no column truth_y"), std::string::npos);
+  EXPECT_NE(refusal("source,truth_x,truth_y,error_m\nndt,1,2\n").find("bad.csv:2: 3 fields"), std::string::npos);
+  EXPECT_NE(refusal("source,truth_x,truth_y,error_m\nndt,1,2,0.01\nndt,1,nan,0.01\n").find("bad.csv:3: truth_y: 'nan' is not a finite number"), std::string::npos);
+  EXPECT_NE(refusal("source,truth_x,truth_y,error_m\nndt,1,2,-0.01\n").find("bad.csv:2: error_m: -0.01 is negative"), std::string::npos);
+  EXPECT_EQ(refusal("source,truth_x,truth_y,error_m\r\nndt,1,2,0.01\r\n"), "taken") << "a file with CRLF line ends";
+  EXPECT_NE(refusal("x").find("no column source"), std::string::npos);
+  EXPECT_THROW(AccuratePlaces::fromInputErrorCsv(dir / "none.csv", 10.0, 0.02), Error);
+  EXPECT_THROW(AccuratePlaces::fromInputErrorCsv(dir / "input_error.csv", 0.0, 0.02), Error) << "the cell checked before the file";
+}
+
 TEST(Evaluation, NdtQualityMapTakesEachPoseAtNdtsPositionAndLeavesOutWhatCannotBePlaced) {
   std::vector<ErrorSample> ndt;
   for (int i = 0; i < 6; ++i) {
