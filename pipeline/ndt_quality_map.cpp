@@ -44,23 +44,25 @@ std::vector<bool> NdtQualityMap::grossErrors(const std::vector<NdtQualitySample>
   return gross;
 }
 
-NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples, double default_variance) {
+NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples,
+                                        std::optional<double> default_variance) {
   if (!(cell >= kMinCell && cell <= kMaxCell)) throw Error("NDT quality map: the cell must be " + std::to_string(kMinCell) + "-" + std::to_string(kMaxCell) + " m");
-  if (!(default_variance >= 0.0 && default_variance <= kMaxVariance)) throw Error("NDT quality map: the default variance must be a finite number of m^2 >= 0");
+  if (default_variance && !(*default_variance >= 0.0 && *default_variance <= kMaxVariance))
+    throw Error("NDT quality map: the default variance must be a finite number of m^2 >= 0");
   const std::vector<bool> gross = grossErrors(samples, cell);
   NdtQualityMap map;
   map.cell_ = cell;
-  map.default_variance_ = default_variance;
   map.gross_left_out_ = static_cast<std::size_t>(std::count(gross.begin(), gross.end(), true));
   std::map<std::pair<long long, long long>, std::pair<double, std::size_t>> sums;
-  double change = 0.0;
-  std::size_t changes = 0;
+  double change = 0.0, all = 0.0;  // all: the drive's own sum, for the default
+  std::size_t changes = 0, poses = 0;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const NdtQualitySample& s = samples[i];
     if (gross[i]) continue;
     auto& sum = sums[map.indexOf(s.position)];
     sum.first += 0.5 * s.error.squaredNorm();  // x and y pooled
     ++sum.second;
+    all += 0.5 * s.error.squaredNorm(), ++poses;
     // Two independent draws of the noise differ by twice its variance, per axis; x and y pooled.
     if (i > 0 && !gross[i - 1] && (s.position - samples[i - 1].position).norm() < cell) {
       change += 0.25 * (s.error - samples[i - 1].error).squaredNorm();
@@ -68,6 +70,7 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
     }
   }
   if (changes > 0) map.noise_variance_ = std::min(change / static_cast<double>(changes), kMaxVariance);
+  map.default_variance_ = default_variance ? *default_variance : poses ? std::min(all / static_cast<double>(poses), kMaxVariance) : 0.0;
   for (const auto& [index, sum] : sums)
     if (sum.second >= std::max<std::size_t>(min_samples, 1)) map.cells_[index] = {sum.first / static_cast<double>(sum.second), sum.second};
   return map;

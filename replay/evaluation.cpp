@@ -154,13 +154,7 @@ pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, doubl
     if (!s.estimate.allFinite() || !s.truth.allFinite() || s.estimate.cwiseAbs().maxCoeff() > 1e9) continue;
     samples.push_back({s.estimate, s.estimate - s.truth});
   }
-  // The drive's own figure, for places without a cell, leaves the gross errors out as the cells do.
-  const std::vector<bool> gross = pipeline::NdtQualityMap::grossErrors(samples, cell);
-  double sum = 0.0;
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < samples.size(); ++i)
-    if (!gross[i]) sum += 0.5 * samples[i].error.squaredNorm(), ++kept;
-  return pipeline::NdtQualityMap::fromErrors(samples, cell, min_poses, kept ? sum / static_cast<double>(kept) : 0.0);
+  return pipeline::NdtQualityMap::fromErrors(samples, cell, min_poses);  // elsewhere the drive's own mean square
 }
 
 }  // namespace coloc::replay

@@ -73,6 +73,9 @@ TEST(NdtQualityMap, AScanMatchedFarOffIsLeftOutOfItsPlaceAndOfTheScanToScanNoise
   const NdtQualityMap reference = NdtQualityMap::fromErrors(without, 10.0, 5, 0.0);
   EXPECT_DOUBLE_EQ(with.varianceAt({105.0, -2.0}), reference.varianceAt({105.0, -2.0}));
   EXPECT_LT(with.varianceAt({105.0, -2.0}), 2e-4) << "about (1 cm)^2 / 2, not the glitch's (34 cm)^2 / 22";
+  // Nor in the drive's own figure, which answers where no cell is listed when no default is given.
+  EXPECT_DOUBLE_EQ(NdtQualityMap::fromErrors(glitch, 10.0, 5).defaultVariance(), NdtQualityMap::fromErrors(without, 10.0, 5).defaultVariance());
+  EXPECT_LT(NdtQualityMap::fromErrors(glitch, 10.0, 5).defaultVariance(), 2e-4);
   // Its two changes (into it and out of it) are left out of the noise, the rest kept.
   EXPECT_LT(with.noiseVariance(), 2e-5);
   EXPECT_NE(with.toYaml().find("1 pose(s) left out as gross errors"), std::string::npos);

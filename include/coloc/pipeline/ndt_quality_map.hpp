@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -29,11 +30,13 @@ class NdtQualityMap {
 
   /// Cells of `cell` m; a cell's variance is the mean square of its poses' x and y errors (pooled, a
   /// bias included: a map's error is NDT's error), kept where it holds at least `min_samples` poses.
-  /// `default_variance` answers elsewhere. The samples in drive order also give NDT's scan-to-scan
-  /// noise: half the mean square change of the error between consecutive poses less than a cell
-  /// apart (what a bias alike from one scan to the next leaves). Gross errors (grossErrors) count in
-  /// neither. Throws coloc::Error for a cell or default out of range or a non-finite sample.
-  static NdtQualityMap fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples, double default_variance);
+  /// `default_variance` answers elsewhere; not given, the drive's own mean square over all its poses.
+  /// The samples in drive order also give NDT's scan-to-scan noise: half the mean square change of the
+  /// error between consecutive poses less than a cell apart (what a bias alike from one scan to the
+  /// next leaves). Gross errors (grossErrors) count in none of these. Throws coloc::Error for a cell or
+  /// default out of range or a non-finite sample.
+  static NdtQualityMap fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples,
+                                  std::optional<double> default_variance = std::nullopt);
 
   /// Which samples are gross errors: more than kGrossError times the median error of their cell's
   /// samples (cells of three or more). One scan NDT matched decimetres off is not the place's error:
