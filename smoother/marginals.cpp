@@ -5,15 +5,22 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "residuals.hpp"
+
 namespace coloc::smoother {
 
-using Block = Eigen::MatrixXd;
+namespace {
 
-ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads,
-                              int size) {
+// The recursion with blocks of `Size` rows (Eigen::Dynamic: `size`). The smoother's states have a size
+// known when compiling, and blocks of that size live on the stack: the dynamic blocks' allocations and
+// general products took most of the sweep.
+template <int Size>
+ChainMarginals chainMarginalsOf(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads,
+                                int size) {
+  using Block = Eigen::Matrix<double, Size, Size>;
+  using Rows = Eigen::Matrix<double, Size, Eigen::Dynamic>;
   ChainMarginals out;
   const std::size_t n = states.size();
-  if (n == 0) return out;
 
   // The Jacobian, losses applied, with columns in the order asked for: states first, then the globals.
   ceres::Problem::EvaluateOptions eo;
@@ -27,6 +34,9 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
   const int m = J.num_cols - state_columns;  // the globals' tangent dimensions together
 
   // H = J^T J as D (diagonal blocks), E (the block right of each diagonal one), B (states x globals), C.
+  // Each entry's block and place in it, once per entry rather than once per product.
+  std::vector<int> block_of(J.cols.size()), within(J.cols.size());
+  for (std::size_t e = 0; e < J.cols.size(); ++e) block_of[e] = J.cols[e] / size, within[e] = J.cols[e] % size;
   std::vector<Block> D(n, Block::Zero(size, size)), E(n, Block::Zero(size, size));
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(state_columns, m), C = Eigen::MatrixXd::Zero(m, m);
   for (int r = 0; r < J.num_rows; ++r) {
@@ -39,9 +49,10 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
         const int cb = J.cols[b];
         const double v = va * J.values[b];
         if (ca < state_columns && cb < state_columns) {
-          const int ka = ca / size, kb = cb / size;
-          if (ka == kb) D[ka](ca % size, cb % size) += v;
-          else if (kb == ka + 1) E[ka](ca % size, cb % size) += v;
+          const int ka = block_of[static_cast<std::size_t>(a)], kb = block_of[static_cast<std::size_t>(b)];
+          const int ia = within[static_cast<std::size_t>(a)], ib = within[static_cast<std::size_t>(b)];
+          if (ka == kb) D[static_cast<std::size_t>(ka)](ia, ib) += v;
+          else if (kb == ka + 1) E[static_cast<std::size_t>(ka)](ia, ib) += v;
           else if (ka != kb + 1) return out;  // not a chain
         } else if (ca < state_columns) {
           B(ca, cb - state_columns) += v;
@@ -58,8 +69,12 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
   for (std::size_t k = 0; k < n; ++k) {
     Block s = D[k];
     if (k > 0) {
-      s -= E[k - 1].transpose() * S[k - 1].solve(E[k - 1]);
-      if (m > 0) Y.middleRows(size * k, size) -= E[k - 1].transpose() * S[k - 1].solve(Y.middleRows(size * (k - 1), size));
+      const Block solved = S[k - 1].solve(E[k - 1]);
+      s -= E[k - 1].transpose() * solved;
+      if (m > 0) {
+        const Rows y = S[k - 1].solve(Rows(Y.middleRows(size * (k - 1), size)));
+        Y.middleRows(size * k, size) -= E[k - 1].transpose() * y;
+      }
     }
     S[k].compute(s);
     if (S[k].info() != Eigen::Success) return out;
@@ -70,11 +85,18 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
   out.states.resize(n);
   const Block I = Block::Identity(size, size);
   out.states[n - 1] = S[n - 1].solve(I);
-  if (m > 0) X.middleRows(size * (n - 1), size) = S[n - 1].solve(Y.middleRows(size * (n - 1), size));
+  Block next = S[n - 1].solve(I);  // the marginal of the state after k, kept in a block of its size
+  out.states[n - 1] = next;
+  if (m > 0) X.middleRows(size * (n - 1), size) = S[n - 1].solve(Rows(Y.middleRows(size * (n - 1), size)));
   for (std::size_t k = n - 1; k-- > 0;) {
     const Block G = S[k].solve(E[k]);
-    out.states[k] = S[k].solve(I) + G * out.states[k + 1] * G.transpose();
-    if (m > 0) X.middleRows(size * k, size) = S[k].solve(Y.middleRows(size * k, size)) - G * X.middleRows(size * (k + 1), size);
+    const Block marginal = S[k].solve(I) + G * next * G.transpose();
+    out.states[k] = marginal;
+    next = marginal;
+    if (m > 0) {
+      const Rows later = X.middleRows(size * (k + 1), size);
+      X.middleRows(size * k, size) = S[k].solve(Rows(Y.middleRows(size * k, size))) - G * later;
+    }
   }
 
   // The globals: their covariance is the inverse of their Schur complement C - B^T A^-1 B, and each
@@ -97,6 +119,15 @@ ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*
   }
   out.ok = true;
   return out;
+}
+
+}  // namespace
+
+ChainMarginals chainMarginals(ceres::Problem& problem, const std::vector<double*>& states, const std::vector<double*>& globals, int threads,
+                              int size) {
+  if (states.empty()) return {};
+  if (size == residuals::kState) return chainMarginalsOf<residuals::kState>(problem, states, globals, threads, size);
+  return chainMarginalsOf<Eigen::Dynamic>(problem, states, globals, threads, size);
 }
 
 }  // namespace coloc::smoother

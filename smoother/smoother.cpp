@@ -358,6 +358,12 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = o.max_iterations;
+  // The problem is nearly linear about the filter's states (its rotations turn by fractions of a degree
+  // between guess and optimum), so Gauss-Newton's full step is the right first step. Ceres's default
+  // first radius (1e4) damps it: on site B's 1,835 states the solves took 27 iterations in all, against
+  // 11 from 1e6, and the smoothed track moved by under 0.01 mm. A step that fails still shrinks the
+  // region as before.
+  solver.initial_trust_region_radius = 1e6;
   solver.num_threads = std::max(1, o.threads);
   solver.minimizer_progress_to_stdout = false;
   solver.logging_type = ceres::SILENT;
