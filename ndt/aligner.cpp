@@ -5,6 +5,7 @@
 #include <chrono>
 #include <mutex>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "coloc/core/error.hpp"
@@ -32,6 +33,9 @@ struct Optimisation {
   int iterations = 0;
   int oscillations = 0;
   bool converged = false;
+  /// The score at `pose` over all the points, with NVTL when the neighbourhood is the radius one (the
+  /// fast backend's last evaluation; else none).
+  std::optional<ScoreEvaluation> at_pose;
 };
 
 // Newton's method on the NDT score inside a trust region (More & Sorensen 1983; Nocedal & Wright ch. 4).
@@ -103,28 +107,42 @@ bool iterate(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& 
   ScoreOptions options;
   options.neighborhood = config.neighborhood;
   options.threads = config.threads;
-  auto evaluate = [&](const Vector6d& p) {
-    return evaluateScore(target.voxels, config.resolution, target.constants, points, p, options, &cache);
+  // NVTL in the same pass costs a comparison per voxel: the last evaluation, at the result, then
+  // serves as the final one.
+  options.nvtl = config.neighborhood == Neighborhood::kRadius;
+  auto evaluateWith = [&](const Vector6d& p, const ScoreOptions& o) {
+    return evaluateScore(target.voxels, config.resolution, target.constants, points, p, o, &cache);
   };
+  auto evaluate = [&](const Vector6d& p) { return evaluateWith(p, options); };
+  ScoreOptions score_only = options;
+  score_only.gradient = score_only.hessian = false;
+  const bool hessian_at_result = config.covariance == CovarianceMode::kLaplace;
   ScoreEvaluation current = evaluate(pose);
+  // Every return leaves `pose` where `current` was evaluated.
+  auto done = [&](bool converged) {
+    if (options.nvtl) out.at_pose = current;
+    return converged;
+  };
   // The radius grows to half a voxel at most: the score's model is local to the voxels a point sees.
   const double max_radius = std::max(config.step_size, 0.5 * config.resolution);
   auto scaledNorm = [](const Vector6d& s) { return std::sqrt(s.head<3>().squaredNorm() + kLeverArm * kLeverArm * s.tail<3>().squaredNorm()); };
   while (out.iterations < config.max_iterations) {
     if (!current.gradient.allFinite() || !current.hessian.allFinite() || current.gradient.norm() == 0.0)
-      return true;  // nothing to step on (no point sees a voxel)
+      return done(true);  // nothing to step on (no point sees a voxel)
     const TrustStep ts = trustRegionStep(current.gradient, current.hessian, radius);
     const Vector6d& step = ts.step;
-    if (!step.allFinite()) return false;
+    if (!step.allFinite()) return done(false);
     const bool small = ts.newton && step.head<3>().squaredNorm() <= config.transformation_epsilon && step.tail<3>().norm() <= kRotationEpsilon;
-    ScoreEvaluation trial = evaluate(pose + step);
+    // After a small step the iterations end whatever the trial gives: its derivatives are never used
+    // unless the covariance needs the Hessian at the result. The score and NVTL are the same bits.
+    ScoreEvaluation trial = small && !hessian_at_result ? evaluateWith(pose + step, score_only) : evaluate(pose + step);
     ++out.iterations;
     const double gain = trial.score - current.score;
     const double length = scaledNorm(step);
     if (!(gain >= 0.0)) {
       // Refused: the model overreached. Shrink below this step; give up once the smallest fails.
       radius = 0.25 * std::min(radius, length);
-      if (small || radius < kSmallestRadius) return true;
+      if (small || radius < kSmallestRadius) return done(true);
       continue;
     }
     const double predicted = current.gradient.dot(step) + 0.5 * step.dot(current.hessian * step);
@@ -133,14 +151,14 @@ bool iterate(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& 
     else if (agreement < 0.25) radius = std::max(0.25 * length, kSmallestRadius);
     pose += step;
     current = std::move(trial);
-    if (small) return true;
+    if (small) return done(true);
     const Eigen::Vector3d translation = step.head<3>();
     if (previous_step.norm() > 0.0 && translation.norm() > 0.0 &&
         previous_step.dot(translation) / (previous_step.norm() * translation.norm()) < -0.9)
       ++out.oscillations;
     previous_step = translation;
   }
-  return false;
+  return done(false);
 }
 
 // A dense scan first converges on an evenly spread subset of kCoarsePoints points, then on all of them:
@@ -303,7 +321,10 @@ AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, cons
   options.hessian = config.covariance == CovarianceMode::kLaplace;
   options.gradient = options.hessian;
   options.threads = config.threads;
-  const ScoreEvaluation eval = evaluateScore(t.voxels, config.resolution, t.constants, source.points, opt.pose, options, fast ? &cache : nullptr);
+  // The fast backend's last evaluation is this one, with the derivatives besides (the same bits: the
+  // same points, pose, voxels and order of sums).
+  const ScoreEvaluation eval =
+      opt.at_pose ? *opt.at_pose : evaluateScore(t.voxels, config.resolution, t.constants, source.points, opt.pose, options, fast ? &cache : nullptr);
   result.transform_probability = eval.score / static_cast<double>(source.size());
   result.nvtl = eval.nvtl_points ? eval.nvtl_sum / static_cast<double>(eval.nvtl_points) : 0.0;
 

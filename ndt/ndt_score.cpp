@@ -151,17 +151,22 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
       // same bits as the largest of the exps).
       const bool nvtl_here = options.nvtl && options.neighborhood == Neighborhood::kRadius;
       double best_exponent = 0.0;
+      // The best voxel's exp, when the score computed it: NVTL then costs no exp of its own.
+      double best_e = 0.0;
+      bool best_known = false;
       auto visit = [&](const Voxel& v) {
         const Vector3d q = xt - v.mean;
         if (options.neighborhood == Neighborhood::kRadius && q.squaredNorm() > radius_sq) return;
         const Vector3d Cq = v.inverse_covariance * q;
         const double exponent = -0.5 * k.d2 * q.dot(Cq);
-        if (nvtl_here && (!any || exponent > best_exponent)) best_exponent = exponent;
+        const bool best = nvtl_here && (!any || exponent > best_exponent);
+        if (best) best_exponent = exponent, best_known = false;
         any = true;
         // Beyond e^-40 (4e-18 of a voxel's full weight) a term cannot change a double sum of terms up
         // to 1: skipping it saves the exp and the derivatives of the many voxels a point barely touches.
         if (exponent < -40.0) return;
         const double e = std::exp(exponent);
+        if (best) best_e = e, best_known = true;
         point_score += -k.d1 * e;
         if (!options.gradient) return;
         const double f = k.d1 * k.d2 * e;
@@ -192,7 +197,7 @@ ScoreEvaluation evaluateScore(const VoxelLookup& voxels, double resolution, cons
       }
       if (nvtl_here) {
         if (any) {
-          local.nvtl_sum += -k.d1 * std::exp(best_exponent);
+          local.nvtl_sum += -k.d1 * (best_known ? best_e : std::exp(best_exponent));
           ++local.nvtl_points;
         }
       } else if (options.nvtl) {
@@ -251,40 +256,57 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
     // The cells this point's shifts fell into so far, and their lists: nearby shifts share a cell.
     std::vector<std::pair<std::uint64_t, CellNeighbours::List>> seen;
     std::vector<std::uint32_t> scratch;
+    std::vector<Vector3d> shifted(m);
+    std::vector<std::uint64_t> keys(m);
+    std::vector<Eigen::Vector3i> cells_of(m);
+    std::vector<double> best(m);
+    std::vector<char> found(m), done(m);
+    std::vector<std::size_t> group;
 #pragma omp for schedule(static) nowait
     for (long idx = 0; idx < n; ++idx) {
       const Vector3d xt = R * source[static_cast<std::size_t>(idx)].cast<double>() + t;
       seen.clear();
       for (std::size_t j = 0; j < m; ++j) {
+        shifted[j] = xt + translations[j];
+        cells_of[j] = (shifted[j] * inverse_resolution).array().floor().cast<int>();
+        keys[j] = VoxelLookup::pack(cells_of[j]);
+        best[j] = 0.0, found[j] = 0, done[j] = 0;
+      }
+      for (std::size_t j = 0; j < m; ++j) {
+        if (done[j]) continue;
         // Each shifted point looks at the voxels its own cell's list holds, as the score does: every
         // voxel within reach is in it, so the largest exponent is the one of the whole neighbourhood.
-        const Vector3d shifted = xt + translations[j];
-        const Eigen::Vector3i cell = (shifted * inverse_resolution).array().floor().cast<int>();
-        const std::uint64_t key = VoxelLookup::pack(cell);
+        // The shifts in the same cell walk the list together, each voxel read once for all of them (the
+        // same sums per shift, in the same order).
+        group.clear();
+        for (std::size_t g = j; g < m; ++g)
+          if (!done[g] && keys[g] == keys[j]) group.push_back(g), done[g] = 1;
+        const std::uint64_t key = keys[j];
         CellNeighbours::List list;
         if (cache && cache->cell_[static_cast<std::size_t>(idx)] == key) {
           list = cache->list_[static_cast<std::size_t>(idx)];  // still in the cell the alignment last saw the point in
         } else if (const auto at = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == key; }); at != seen.end()) {
           list = at->second;
         } else {
-          list = cells.get(cell, key, scratch);
+          list = cells.get(cells_of[j], key, scratch);
           if (list.kept) seen.emplace_back(key, list);  // a list not kept lasts one use
         }
-        double best = 0.0;
-        bool found = false;
         for (std::uint32_t i = 0; i < list.size; ++i) {
           const Voxel& v = voxels.voxels()[list.voxels[i]];
-          const Vector3d q = shifted - v.mean;
-          if (q.squaredNorm() > radius_sq) continue;
-          const double exponent = -0.5 * k.d2 * q.dot(v.inverse_covariance * q);
-          if (!found || exponent > best) best = exponent;
-          found = true;
-        }
-        if (found) {
-          sums[thread][j] += -k.d1 * std::exp(best);
-          ++counts[thread][j];
+          for (const std::size_t g : group) {
+            const Vector3d q = shifted[g] - v.mean;
+            if (q.squaredNorm() > radius_sq) continue;
+            const double exponent = -0.5 * k.d2 * q.dot(v.inverse_covariance * q);
+            if (!found[g] || exponent > best[g]) best[g] = exponent;
+            found[g] = 1;
+          }
         }
       }
+      for (std::size_t j = 0; j < m; ++j)
+        if (found[j]) {
+          sums[thread][j] += -k.d1 * std::exp(best[j]);
+          ++counts[thread][j];
+        }
     }
   }
   std::vector<double> nvtl(m, 0.0);
