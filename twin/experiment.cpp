@@ -5,6 +5,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -275,38 +276,87 @@ void runJob(Job& job) {
   job.run.replay_seconds = r.wall_seconds;
 }
 
-// Runs the jobs side by side; the first error stops the rest and is rethrown.
-void runJobs(std::vector<Job>& jobs, int threads) {
-  // The longest first (a smoothed replay, then a whole one, then one that ends with the coverage): the
-  // last to finish is then a short one, and the threads end together. Each job is computed alone, so
-  // the order changes no result (the tables the same to the digit). On the quick run the time one
-  // thread waited for the other at the drives' ends went 3.0 -> 0.6 s (of 33 s of replays); on the full
-  // run 26.4 -> 24.3 s (of 410 s), where most of it is drives of two or three replays alike.
-  std::vector<std::size_t> order(jobs.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  const auto weight = [](const Job& j) { return (j.smooth || j.calibrate ? 2 : 0) + (j.until == 0 ? 1 : 0); };
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return weight(jobs[a]) > weight(jobs[b]); });
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr failure;
-  std::mutex mutex;
-  auto worker = [&] {
-    for (std::size_t k; (k = next++) < jobs.size();) {
-      const std::size_t i = order[k];
-      try {
-        runJob(jobs[i]);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        next = jobs.size();
-      }
-    }
+// The drives' jobs side by side on a few threads. Each drive's jobs run longest first (a smoothed
+// replay, then a whole one, then one that ends with the coverage), and the drives in the order they
+// are queued: a thread that ends a drive's last job goes on to the next drive's instead of waiting for
+// its partner, which left a thread idle at every drive's end (on the full run 24 s of 410 s of
+// replays, most of it drives of two or three replays alike). Each job is computed alone, so the order
+// changes no result.
+class JobPool {
+ public:
+  /// One drive's jobs; `left` counts those not yet run.
+  struct Batch {
+    std::vector<Job>* jobs = nullptr;
+    std::size_t left = 0;
+    std::exception_ptr failure;  ///< the first job's error: the drive's other jobs are skipped
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, static_cast<int>(jobs.size())); ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
-}
+
+  explicit JobPool(int threads) {
+    for (int t = 0; t < std::max(1, threads); ++t) workers_.emplace_back([this] { work(); });
+  }
+  ~JobPool() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+      queue_.clear();  // an error stopped the experiment: what is queued is not wanted
+    }
+    wake_.notify_all();
+    for (std::thread& t : workers_) t.join();
+  }
+  JobPool(const JobPool&) = delete;
+  JobPool& operator=(const JobPool&) = delete;
+
+  /// Queues `batch`'s jobs, which must stay where they are until wait(batch) returns.
+  void submit(Batch& batch) {
+    std::vector<Job>& jobs = *batch.jobs;
+    std::vector<std::size_t> order(jobs.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    const auto weight = [](const Job& j) { return (j.smooth || j.calibrate ? 2 : 0) + (j.until == 0 ? 1 : 0); };
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return weight(jobs[a]) > weight(jobs[b]); });
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      batch.left = jobs.size();
+      for (std::size_t i : order) queue_.emplace_back(&batch, i);
+    }
+    wake_.notify_all();
+  }
+  /// Until every job of `batch` has run; rethrows the first error of one.
+  void wait(Batch& batch) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [&] { return batch.left == 0; });
+    if (batch.failure) std::rethrow_exception(batch.failure);
+  }
+
+ private:
+  void work() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;
+      const auto [batch, i] = queue_.front();
+      queue_.pop_front();
+      const bool skip = batch->failure != nullptr;
+      lock.unlock();
+      std::exception_ptr failure;
+      if (!skip) {
+        try {
+          runJob((*batch->jobs)[i]);
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      }
+      lock.lock();
+      if (failure && !batch->failure) batch->failure = failure;
+      if (--batch->left == 0) done_.notify_all();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  std::deque<std::pair<Batch*, std::size_t>> queue_;
+  bool stopping_ = false;
+  std::vector<std::thread> workers_;
+};
 
 // The variance per axis of an RSU's fix errors against ground truth: the "estimated from the data"
 // covariance, as a calibration drive past the RSU would give it. Robust (from the median absolute
@@ -549,11 +599,109 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       ahead.push_back(std::async(std::launch::async, record, launched++));
     }
   };
+  // A drive whose replays are queued: noted (its runs into the results, what later drives read of it)
+  // in the order of the drives, once its replays have run.
+  struct InFlight {
+    std::size_t d = 0;
+    Recorded recorded;
+    std::vector<Job> jobs;
+    std::shared_ptr<replay::ReplayCache> cache;
+    Clock::time_point t1;
+    JobPool::Batch batch;
+  };
+  std::deque<std::unique_ptr<InFlight>> in_flight;
+  JobPool pool(config.jobs);
+  auto note = [&](InFlight& f) {
+    const std::size_t d = f.d;
+    const Drive& drive = drives[d];
+    const sim::Scenario& scenario = f.recorded.scenario;
+    const std::string& name = f.recorded.name;
+    const std::string& variant = f.recorded.variant;
+    const TwinRecordingOptions& rec = f.recorded.options;
+    const double simulated_in = f.recorded.seconds;
+    const auto t1 = f.t1;
+    std::vector<Job>& jobs = f.jobs;
+    const std::shared_ptr<replay::ReplayCache>& cache = f.cache;
+    {
+      const ndt::AlignmentMemoStats shared = cache->alignments()->stats();
+      results.timing.matches_asked += shared.asked;
+      results.timing.matches_computed += shared.computed;
+      results.timing.preprocessings_computed += shared.preprocessings_computed;
+    }
+    for (Job& j : jobs) {
+      results.timing.replay += j.run.replay_seconds;
+      if (drive.variant == kNoiseCalibrationDrive) {
+        ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
+        results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
+        accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(replay::AccuratePlaces::fromErrors(
+            j.ndt_errors, j.run.ndt.stretch_length, j.run.ndt.accurate_below, replay::AccuratePlaces::kMinPoses));
+        if (config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
+          const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
+          ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();
+          std::ofstream(ndt_quality[drive.site]) << quality.toYaml();
+          ndt_quality_default[drive.site] = quality.defaultVariance();
+          results.ndt_quality_cells[scenario.name] = quality.cells();
+        }
+        continue;  // never evaluated
+      }
+      if (j.calibrate && j.registry) {
+        bool any = false;
+        for (const rsu_client::RsuInfo& info : j.registry->rsus()) {
+          CalibrationResult c;
+          c.site = scenario.name;
+          c.lidar = j.run.lidar;
+          c.rsu = info.id;
+          for (const sim::ScenarioRsu& r : scenario.rsus)
+            if (r.id == info.id) c.rsu = siteRsuId(r);
+          c.dx = config.calibration_error[0], c.dy = config.calibration_error[1];
+          c.dyaw = config.calibration_error[2] * M_PI / 180.0;
+          c.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
+          if (const auto found = j.calibrations.find(info.id); found != j.calibrations.end()) c.found = found->second;
+          else c.found.note = "no fix of this RSU on the drive";
+          results.calibrations.push_back(c);
+          if (const rsu_client::RsuInfo* calibrated = j.calibrated ? j.calibrated->find(info.id) : nullptr) any = any || calibrated->calibration.has_value();
+        }
+        if (any) calibrated_registries.emplace(std::make_pair(drive.site, j.run.lidar), *j.calibrated);
+      }
+      if (j.smoothed) {
+        results.timing.replay += j.smoothed->replay_seconds;
+        results.runs.push_back(std::move(*j.smoothed));
+      }
+      results.runs.push_back(std::move(j.run));
+    }
+    results.timing.replays += jobs.size();
+    if (progress.fraction) progress.fraction(static_cast<double>(d + 1) / drives.size());
+    if (progress.step) {
+      char line[256];
+      std::snprintf(line, sizeof line, "[%zu/%zu] %s%s%s: drive simulated in %.1f s, %zu replays in %.1f s", d + 1, drives.size(),
+                    name.c_str(), variant.empty() ? "" : ", ", variant.c_str(), simulated_in, jobs.size(), since(t1));
+      progress.step(line);
+    }
+  };
+  auto noteFirst = [&] {
+    pool.wait(in_flight.front()->batch);
+    note(*in_flight.front());
+    in_flight.pop_front();
+  };
+  // At most two drives in flight (their logs in memory beside the drives simulated ahead), and a site's
+  // noise calibration drive (NDT's figures, the RSUs' variance) or calibration drive (the calibrated
+  // registries) noted before the site's next drive's replays are made from what it found.
+  constexpr std::size_t kDrivesInFlight = 2;
+  const auto feeds = [&](const InFlight& f, std::size_t d) {
+    const Drive& earlier = drives[f.d];
+    return earlier.site == drives[d].site && (earlier.variant == kNoiseCalibrationDrive || earlier.variant == kCalibrationDrive);
+  };
   launch(0);
   for (std::size_t d = 0; d < drives.size(); ++d) {
+    while (!in_flight.empty() &&
+           (in_flight.size() >= kDrivesInFlight || std::any_of(in_flight.begin(), in_flight.end(), [&](const auto& f) { return feeds(*f, d); })))
+      noteFirst();
     const Drive& drive = drives[d];
     if (ahead.empty()) launch(d);
-    Recorded recorded = ahead.front().get();
+    auto flight = std::make_unique<InFlight>();
+    flight->d = d;
+    flight->recorded = ahead.front().get();
+    Recorded& recorded = flight->recorded;
     ahead.pop_front();
     if (maps[drive.site].empty()) {
       maps[drive.site] = recorded.summary.map_dir;
@@ -566,7 +714,6 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     }
     launch(d + 1);
     const sim::Scenario& scenario = recorded.scenario;
-    const std::string& name = recorded.name;
     const std::string& variant = recorded.variant;
     const TwinRecordingOptions& rec = recorded.options;
     const TwinRecordingSummary& summary = recorded.summary;
@@ -577,7 +724,6 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     results.timing.reused_sweeps += summary.reused_sweeps;
     results.timing.lidar += summary.lidar_seconds;
     results.timing.driven_seconds += summary.drive_seconds;
-    const double simulated_in = recorded.seconds;
 
     // Its replays.
     pipeline::Config fuse = base;
@@ -601,7 +747,8 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     for (const sim::ScenarioRsu& r : scenario.rsus) rsu_positions.push_back(r.position);
     // The drive's replays read its log once, and each NDT target of the site is built once (the same
     // results as apart).
-    auto cache = std::make_shared<replay::ReplayCache>(site_targets[drive.site]);
+    flight->cache = std::make_shared<replay::ReplayCache>(site_targets[drive.site]);
+    const std::shared_ptr<replay::ReplayCache>& cache = flight->cache;
     cache->add(rec.out_dir + "/log", summary.log);
     // The fixes' variance under each way of setting it; the estimate comes from the site's noise calibration
     // drive (none for an RSU that sent too few fixes there: its fixes keep the covariance they carry).
@@ -689,7 +836,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       return job;
     };
     const RsuCovariance main_covariance = config.rsu_covariance;
-    std::vector<Job> jobs;
+    std::vector<Job>& jobs = flight->jobs;
     if (drive.variant == kNoiseCalibrationDrive) {
       for (const sim::ScenarioRsu& r : scenario.rsus) {
         const auto errors = summary.fix_errors.find(r.id);
@@ -845,64 +992,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
         if (j.run.variant.empty() && j.run.delay == 0.0 && j.run.loss == 0.0) j.smooth = true;
     if (config.recordings)
       for (const Job& j : jobs) writeReplayConfig(j, rec.out_dir + "/replays");
-    const auto t1 = Clock::now();
-    runJobs(jobs, config.jobs);
-    {
-      const ndt::AlignmentMemoStats shared = cache->alignments()->stats();
-      results.timing.matches_asked += shared.asked;
-      results.timing.matches_computed += shared.computed;
-      results.timing.preprocessings_computed += shared.preprocessings_computed;
-    }
-    for (Job& j : jobs) {
-      results.timing.replay += j.run.replay_seconds;
-      if (drive.variant == kNoiseCalibrationDrive) {
-        ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
-        results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
-        accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(replay::AccuratePlaces::fromErrors(
-            j.ndt_errors, j.run.ndt.stretch_length, j.run.ndt.accurate_below, replay::AccuratePlaces::kMinPoses));
-        if (config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
-          const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
-          ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();
-          std::ofstream(ndt_quality[drive.site]) << quality.toYaml();
-          ndt_quality_default[drive.site] = quality.defaultVariance();
-          results.ndt_quality_cells[scenario.name] = quality.cells();
-        }
-        continue;  // never evaluated
-      }
-      if (j.calibrate && j.registry) {
-        bool any = false;
-        for (const rsu_client::RsuInfo& info : j.registry->rsus()) {
-          CalibrationResult c;
-          c.site = scenario.name;
-          c.lidar = j.run.lidar;
-          c.rsu = info.id;
-          for (const sim::ScenarioRsu& r : scenario.rsus)
-            if (r.id == info.id) c.rsu = siteRsuId(r);
-          c.dx = config.calibration_error[0], c.dy = config.calibration_error[1];
-          c.dyaw = config.calibration_error[2] * M_PI / 180.0;
-          c.clock_offset = 1e-3 * config.calibration_clock_offset_ms;
-          if (const auto found = j.calibrations.find(info.id); found != j.calibrations.end()) c.found = found->second;
-          else c.found.note = "no fix of this RSU on the drive";
-          results.calibrations.push_back(c);
-          if (const rsu_client::RsuInfo* calibrated = j.calibrated ? j.calibrated->find(info.id) : nullptr) any = any || calibrated->calibration.has_value();
-        }
-        if (any) calibrated_registries.emplace(std::make_pair(drive.site, j.run.lidar), *j.calibrated);
-      }
-      if (j.smoothed) {
-        results.timing.replay += j.smoothed->replay_seconds;
-        results.runs.push_back(std::move(*j.smoothed));
-      }
-      results.runs.push_back(std::move(j.run));
-    }
-    results.timing.replays += jobs.size();
-    if (progress.fraction) progress.fraction(static_cast<double>(d + 1) / drives.size());
-    if (progress.step) {
-      char line[256];
-      std::snprintf(line, sizeof line, "[%zu/%zu] %s%s%s: drive simulated in %.1f s, %zu replays in %.1f s", d + 1, drives.size(),
-                    name.c_str(), variant.empty() ? "" : ", ", variant.c_str(), simulated_in, jobs.size(), since(t1));
-      progress.step(line);
-    }
+    flight->t1 = Clock::now();
+    flight->batch.jobs = &jobs;
+    pool.submit(flight->batch);
+    in_flight.push_back(std::move(flight));
   }
+  while (!in_flight.empty()) noteFirst();
   results.timing.total = since(start);
   return results;
 }
