@@ -1,7 +1,6 @@
 #include "coloc/twin/experiment.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
