@@ -38,6 +38,9 @@ struct Optimisation {
   std::optional<ScoreEvaluation> at_pose;
 };
 
+// Whether the result's evaluation needs the Hessian: the Laplace covariance is its inverse.
+bool hessianAtResult(const NdtConfig& config) { return config.covariance == CovarianceMode::kLaplace; }
+
 // Newton's method on the NDT score inside a trust region (More & Sorensen 1983; Nocedal & Wright ch. 4).
 // Autoware's ndt_scan_matcher clamps every step to step_size, so a start 2 m off needs 20 of its 30
 // iterations, and where the Hessian is indefinite (far from the optimum; on 1,000-point scans often)
@@ -116,7 +119,7 @@ bool iterate(const NdtTarget::Impl& target, const std::vector<Eigen::Vector3f>& 
   auto evaluate = [&](const Vector6d& p) { return evaluateWith(p, options); };
   ScoreOptions score_only = options;
   score_only.gradient = score_only.hessian = false;
-  const bool hessian_at_result = config.covariance == CovarianceMode::kLaplace;
+  const bool hessian_at_result = hessianAtResult(config);
   ScoreEvaluation current = evaluate(pose);
   // Every return leaves `pose` where `current` was evaluated.
   auto done = [&](bool converged) {
@@ -318,7 +321,7 @@ AlignResult alignFinite(const NdtTarget::Impl& t, const PointCloud& source, cons
   // Scores and the Hessian at the result, over PCL's radius neighbourhood whatever the backend.
   ScoreOptions options;
   options.nvtl = true;
-  options.hessian = config.covariance == CovarianceMode::kLaplace;
+  options.hessian = hessianAtResult(config);
   options.gradient = options.hessian;
   options.threads = config.threads;
   // The fast backend's last evaluation is this one, with the derivatives besides (the same bits: the

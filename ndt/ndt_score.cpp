@@ -253,8 +253,6 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
 #pragma omp parallel num_threads(threads)
   {
     const std::size_t thread = static_cast<std::size_t>(omp_get_thread_num());
-    // The cells this point's shifts fell into so far, and their lists: nearby shifts share a cell.
-    std::vector<std::pair<std::uint64_t, CellNeighbours::List>> seen;
     std::vector<std::uint32_t> scratch;
     std::vector<Vector3d> shifted(m);
     std::vector<std::uint64_t> keys(m);
@@ -265,7 +263,6 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
 #pragma omp for schedule(static) nowait
     for (long idx = 0; idx < n; ++idx) {
       const Vector3d xt = R * source[static_cast<std::size_t>(idx)].cast<double>() + t;
-      seen.clear();
       for (std::size_t j = 0; j < m; ++j) {
         shifted[j] = xt + translations[j];
         cells_of[j] = (shifted[j] * inverse_resolution).array().floor().cast<int>();
@@ -276,8 +273,8 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
         if (done[j]) continue;
         // Each shifted point looks at the voxels its own cell's list holds, as the score does: every
         // voxel within reach is in it, so the largest exponent is the one of the whole neighbourhood.
-        // The shifts in the same cell walk the list together, each voxel read once for all of them (the
-        // same sums per shift, in the same order).
+        // The shifts in the same cell walk its list together, each voxel read once for all of them (the
+        // same sums per shift, in the same order): each list is looked up once per point.
         group.clear();
         for (std::size_t g = j; g < m; ++g)
           if (!done[g] && keys[g] == keys[j]) group.push_back(g), done[g] = 1;
@@ -285,11 +282,8 @@ std::vector<double> nvtlAtTranslations(const VoxelLookup& voxels, double resolut
         CellNeighbours::List list;
         if (cache && cache->cell_[static_cast<std::size_t>(idx)] == key) {
           list = cache->list_[static_cast<std::size_t>(idx)];  // still in the cell the alignment last saw the point in
-        } else if (const auto at = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == key; }); at != seen.end()) {
-          list = at->second;
         } else {
-          list = cells.get(cells_of[j], key, scratch);
-          if (list.kept) seen.emplace_back(key, list);  // a list not kept lasts one use
+          list = cells.get(cells_of[j], key, scratch);  // a list not kept (in `scratch`) is used here only
         }
         for (std::uint32_t i = 0; i < list.size; ++i) {
           const Voxel& v = voxels.voxels()[list.voxels[i]];

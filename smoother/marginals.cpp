@@ -84,7 +84,6 @@ ChainMarginals chainMarginalsOf(ceres::Problem& problem, const std::vector<doubl
   Eigen::MatrixXd X(state_columns, m);
   out.states.resize(n);
   const Block I = Block::Identity(size, size);
-  out.states[n - 1] = S[n - 1].solve(I);
   Block next = S[n - 1].solve(I);  // the marginal of the state after k, kept in a block of its size
   out.states[n - 1] = next;
   if (m > 0) X.middleRows(size * (n - 1), size) = S[n - 1].solve(Rows(Y.middleRows(size * (n - 1), size)));
