@@ -13,6 +13,7 @@
 #include <sstream>
 #include <cstdlib>
 #include <tuple>
+#include <vector>
 
 #include "coloc/core/error.hpp"
 #include "coloc/fusion/verdict.hpp"
@@ -410,13 +411,30 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     struct Pool {
       double n = 0, ndt = 0, fused = 0, settled = 0, acc_n = 0, acc_ndt = 0, acc_fused = 0, acc_settled = 0;
       double place_n = 0, place_ndt = 0, place_fused = 0, place_settled = 0;
+      // Each replay's settled / NDT there: whether a pooled ratio near 1 is a replay's luck or the rule.
+      std::vector<double> acc_ratios, place_ratios;
       void add(const replay::InputComparison& k) {
         n += k.samples, ndt += k.input_mean * k.samples, fused += k.fused_mean * k.samples, settled += k.settled_mean * k.samples;
         acc_n += k.accurate_samples, acc_ndt += k.accurate_input_mean * k.accurate_samples;
         acc_fused += k.accurate_fused_mean * k.accurate_samples, acc_settled += k.accurate_settled_mean * k.accurate_samples;
         place_n += k.place_samples, place_ndt += k.place_input_mean * k.place_samples;
         place_fused += k.place_fused_mean * k.place_samples, place_settled += k.place_settled_mean * k.place_samples;
+        if (k.accurate_samples > 0 && k.accurate_input_mean > 0.0) acc_ratios.push_back(k.accurate_settled_mean / k.accurate_input_mean);
+        if (k.place_samples > 0 && k.place_input_mean > 0.0) place_ratios.push_back(k.place_settled_mean / k.place_input_mean);
       }
+    };
+    // The standard error of the replays' mean ratio (the trials are independent drives); none from one.
+    const auto ratioStandardError = [](const std::vector<double>& ratios) {
+      if (ratios.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+      double mean = 0.0, square = 0.0;
+      for (const double r : ratios) mean += r / static_cast<double>(ratios.size());
+      for (const double r : ratios) square += (r - mean) * (r - mean);
+      return std::sqrt(square / static_cast<double>(ratios.size() - 1) / static_cast<double>(ratios.size()));
+    };
+    const auto csvNumber = [](double x) { return std::isnan(x) ? std::string() : fmt("%.6g", x); };
+    const auto ratioCell = [&](double ratio, const std::vector<double>& ratios) {
+      const double se = ratioStandardError(ratios);
+      return fmt("%.2f", ratio) + (std::isnan(se) ? std::string() : fmt(" ± %.3f", se));
     };
     std::map<std::tuple<double, std::string, std::string>, Pool> by;  // (speed, configuration, site or "")
     double stretch = 0.0, below = 0.0;
@@ -439,7 +457,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     if (!by.empty()) {
       std::ostringstream csv;
       csv << "speed_mps,configuration,site,scans,ndt_mean_m,output_mean_m,settled_mean_m,accurate_scans,accurate_ndt_mean_m,accurate_output_mean_m,"
-             "accurate_settled_mean_m,place_scans,place_ndt_mean_m,place_output_mean_m,place_settled_mean_m\n";
+             "accurate_settled_mean_m,place_scans,place_ndt_mean_m,place_output_mean_m,place_settled_mean_m,"
+             "accurate_replays,accurate_ratio_se,place_replays,place_ratio_se\n";
       ndt_md << "NDT's own pose per scan beside the filter at the same stamps, the sites and trials pooled: its output as given out "
                 "then (interpolated between ticks; it cannot know that scan's pose yet, which comes a sweep and a match later), and "
                 "its estimate for the stamp once that scan's pose is in (settled: the same information NDT's pose has, and what came "
@@ -448,7 +467,9 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
              << " (chosen by stretch, not by scan, which would favour NDT by its luck on those scans). Chosen by this drive's own "
                 "NDT error, a stretch is still chosen for its luck on it, most at speed, where it holds few scans; \"where NDT was "
                 "accurate\" chooses the places (cells of "
-             << fmt("%.0f m", stretch) << ") by the same criterion on the site's noise calibration drive, another drive over the same road.\n\n"
+             << fmt("%.0f m", stretch) << ") by the same criterion on the site's noise calibration drive, another drive over the same road. "
+                "Each ratio's ± is the standard error of the mean of its replays' own ratios (each replay a drive of its own; "
+                "`*_ratio_se` in the CSV, beside the replays counted): a ratio within it of 1 is not told from 1 by these drives.\n\n"
              << "| speed | configuration | NDT per scan | output | settled | scans where NDT is accurate | NDT there | output there | settled there | settled / NDT there "
                 "| scans where NDT was accurate | NDT there | settled there | settled / NDT there |\n"
                 "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -457,20 +478,22 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         csv << speed << "," << configuration << "," << (site.empty() ? "all" : site) << "," << p.n << "," << p.ndt / p.n << "," << p.fused / p.n << ","
             << p.settled / p.n << "," << p.acc_n << "," << (p.acc_n ? p.acc_ndt / p.acc_n : 0.0) << "," << (p.acc_n ? p.acc_fused / p.acc_n : 0.0) << ","
             << (p.acc_n ? p.acc_settled / p.acc_n : 0.0) << "," << p.place_n << "," << (p.place_n ? p.place_ndt / p.place_n : 0.0) << ","
-            << (p.place_n ? p.place_fused / p.place_n : 0.0) << "," << (p.place_n ? p.place_settled / p.place_n : 0.0) << "\n";
+            << (p.place_n ? p.place_fused / p.place_n : 0.0) << "," << (p.place_n ? p.place_settled / p.place_n : 0.0) << ","
+            << p.acc_ratios.size() << "," << csvNumber(ratioStandardError(p.acc_ratios)) << "," << p.place_ratios.size() << ","
+            << csvNumber(ratioStandardError(p.place_ratios)) << "\n";
         if (!site.empty()) continue;
         ndt_md << "| " << fmt("%.0f m/s", speed) << " | " << configuration << " | " << fmt("%.2f cm", 100 * p.ndt / p.n) << " | "
                << fmt("%.2f cm", 100 * p.fused / p.n) << " | " << fmt("%.2f cm", 100 * p.settled / p.n) << " | "
                << fmt("%.0f %%", 100 * p.acc_n / p.n) << " | ";
         if (p.acc_n > 0)
           ndt_md << fmt("%.2f cm", 100 * p.acc_ndt / p.acc_n) << " | " << fmt("%.2f cm", 100 * p.acc_fused / p.acc_n) << " | "
-                 << fmt("%.2f cm", 100 * p.acc_settled / p.acc_n) << " | " << fmt("%.2f", p.acc_settled / p.acc_ndt) << " | ";
+                 << fmt("%.2f cm", 100 * p.acc_settled / p.acc_n) << " | " << ratioCell(p.acc_settled / p.acc_ndt, p.acc_ratios) << " | ";
         else
           ndt_md << "- | - | - | - | ";
         ndt_md << fmt("%.0f %%", 100 * p.place_n / p.n) << " | ";
         if (p.place_n > 0)
           ndt_md << fmt("%.2f cm", 100 * p.place_ndt / p.place_n) << " | " << fmt("%.2f cm", 100 * p.place_settled / p.place_n) << " | "
-                 << fmt("%.2f", p.place_settled / p.place_ndt) << " |\n";
+                 << ratioCell(p.place_settled / p.place_ndt, p.place_ratios) << " |\n";
         else
           ndt_md << "- | - | - |\n";
       }

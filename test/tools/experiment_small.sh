@@ -91,9 +91,15 @@ read -r asked matched preprocessed <<< "$(echo "$shared" | grep -oE '[0-9]+' | t
 # row of ndt_vs_fused.csv counts such scans among its own, with NDT's error there where it has any. (The
 # small site's NDT errs 5-6 cm everywhere: it has no such place; the choice itself is pinned by the
 # replay test AccuratePlaces.*.)
-# speed_mps,configuration,site,scans,...,place_scans,place_ndt_mean_m,place_output_mean_m,place_settled_mean_m
-places=$(awk -F, 'NR == 1 { ok = NF == 15 && $12 == "place_scans" && $13 == "place_ndt_mean_m" && $15 == "place_settled_mean_m"; next }
+# Each row also counts the replays behind its ratios and, from two on, their standard error; a row with
+# scans there has a replay there, and no row more replays than the trials (two; one site).
+# speed_mps,configuration,site,scans,...,place_scans,place_ndt_mean_m,place_output_mean_m,place_settled_mean_m,
+# accurate_replays,accurate_ratio_se,place_replays,place_ratio_se
+places=$(awk -F, 'NR == 1 { ok = NF == 19 && $12 == "place_scans" && $13 == "place_ndt_mean_m" && $15 == "place_settled_mean_m" &&
+                             $16 == "accurate_replays" && $17 == "accurate_ratio_se" && $18 == "place_replays" && $19 == "place_ratio_se"; next }
          $12 > $4 || $12 < 0 || ($12 > 0 && !($13 > 0 && $15 > 0)) { ok = 0 }
+         ($8 > 0) != ($16 > 0) || ($12 > 0) != ($18 > 0) || $16 > 2 || $18 > 2 { ok = 0 }
+         ($16 < 2 && $17 != "") || ($16 >= 2 && !($17 >= 0)) || ($18 < 2 && $19 != "") || ($18 >= 2 && !($19 >= 0)) { ok = 0 }
          { n++ }
          END { if (ok && n) print n; else print "bad" }' "$work/out/ndt_vs_fused.csv")
 [ "$places" != "bad" ] || { echo "FAIL: ndt_vs_fused.csv does not count the scans where NDT was accurate on the noise calibration drive"; exit 1; }

@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "builtin_scenarios.hpp"
 #include "coloc/core/error.hpp"
@@ -229,6 +232,59 @@ TEST(ExperimentReport, TheNetworkChangeIsPooledOverTheSitesWhereNdtFallsShortWit
   results.sites.erase(results.sites.begin());
   writeExperimentReport(results, dir, "coloc experiment");
   EXPECT_EQ(fileText(dir + "/network.csv").find("ndt_falls_short"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// The filter beside NDT where NDT is accurate: the pooled ratio (weighted by scans) with the standard
+// error of its replays' own ratios, so that a ratio near 1 is read against what the drives can tell.
+// Three trials of one site, NDT alone: settled / NDT there 0.9, 1.0 and 1.1 on 10, 20 and 10 scans.
+TEST(ExperimentReport, TheFilterBesideNdtWhereNdtIsAccurateCarriesItsReplaysStandardError) {
+  ExperimentResults results;
+  ExperimentConfig& c = results.config;
+  c.sites = {"site_x"};
+  c.trials = 3;
+  c.lidars = {"VLP-16"};
+  c.network = c.smoother = c.calibration = c.sweeps = false;
+  SiteInfo info;
+  info.name = "site_x";
+  info.drive_length = 20.0;
+  info.cruise_speed = 10.0;
+  results.sites.push_back(info);
+  const double ratios[3] = {0.9, 1.0, 1.1};
+  const std::size_t scans[3] = {10, 20, 10};
+  for (int t = 0; t < 3; ++t) {
+    ExperimentRun r = flatRun("site_x", t, "", 0.0, 0.0, 0.02);
+    replay::InputComparison& k = r.ndt;
+    k.samples = 100, k.input_mean = 0.03, k.fused_mean = k.settled_mean = 0.03;
+    k.stretch_length = 10.0, k.accurate_below = 0.02;
+    k.accurate_samples = scans[t], k.accurate_input_mean = 0.01, k.accurate_fused_mean = k.accurate_settled_mean = 0.01 * ratios[t];
+    if (t == 0) k.place_samples = 5, k.place_input_mean = 0.01, k.place_fused_mean = k.place_settled_mean = 0.012;  // one replay only
+    results.runs.push_back(r);
+  }
+  const std::string dir = ::testing::TempDir() + "/coloc_ndt_vs_fused_report";
+  std::filesystem::create_directories(dir);
+  writeExperimentReport(results, dir, "coloc experiment");
+  std::istringstream csv(fileText(dir + "/ndt_vs_fused.csv"));
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header.substr(header.rfind(",place_settled_mean_m")), ",place_settled_mean_m,accurate_replays,accurate_ratio_se,place_replays,place_ratio_se");
+  std::vector<std::string> field;
+  while (std::getline(csv, line))
+    if (line.find(",site_x,") != std::string::npos) {
+      std::istringstream fields(line);
+      for (std::string f; std::getline(fields, f, ',');) field.push_back(f);
+      if (line.back() == ',') field.push_back("");
+    }
+  ASSERT_EQ(field.size(), 19u) << fileText(dir + "/ndt_vs_fused.csv");
+  // Pooled by scans: (10 x 0.9 + 20 x 1.0 + 10 x 1.1) / 40 = 1.0; the replays' ratios: sd 0.1, over sqrt(3).
+  EXPECT_NEAR(std::stod(field[10]) / std::stod(field[8]), 1.0, 1e-9);
+  EXPECT_EQ(field[15], "3");
+  EXPECT_NEAR(std::stod(field[16]), 0.1 / std::sqrt(3.0), 1e-6);
+  EXPECT_EQ(field[17], "1");
+  EXPECT_EQ(field[18], "");  // one replay tells no spread
+  const std::string report = fileText(dir + "/README.md");
+  EXPECT_NE(report.find("| 1.00 ± 0.058 |"), std::string::npos) << report;
+  EXPECT_NE(report.find("| 1.20 |"), std::string::npos) << report;
   std::filesystem::remove_all(dir);
 }
 
