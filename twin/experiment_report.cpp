@@ -32,6 +32,8 @@ namespace {
 struct Spread {
   double mean = 0.0, sd = 0.0, min = 0.0, max = 0.0;
   std::size_t n = 0;
+  /// The mean's standard error (the values independent: each from a drive of its own); NaN from fewer than two.
+  double standardError() const { return n > 1 ? sd / std::sqrt(static_cast<double>(n)) : std::numeric_limits<double>::quiet_NaN(); }
 };
 
 Spread spread(const std::vector<double>& v) {
@@ -423,14 +425,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         if (k.place_samples > 0 && k.place_input_mean > 0.0) place_ratios.push_back(k.place_settled_mean / k.place_input_mean);
       }
     };
-    // The standard error of the replays' mean ratio (the trials are independent drives); none from one.
-    const auto ratioStandardError = [](const std::vector<double>& ratios) {
-      if (ratios.size() < 2) return std::numeric_limits<double>::quiet_NaN();
-      double mean = 0.0, square = 0.0;
-      for (const double r : ratios) mean += r / static_cast<double>(ratios.size());
-      for (const double r : ratios) square += (r - mean) * (r - mean);
-      return std::sqrt(square / static_cast<double>(ratios.size() - 1) / static_cast<double>(ratios.size()));
-    };
+    const auto ratioStandardError = [](const std::vector<double>& ratios) { return spread(ratios).standardError(); };
     const auto csvNumber = [](double x) { return std::isnan(x) ? std::string() : fmt("%.6g", x); };
     const auto ratioCell = [&](double ratio, const std::vector<double>& ratios) {
       const double se = ratioStandardError(ratios);
@@ -604,13 +599,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
             const ErrorInCoverage ea = errorInCoverage(*a, range, bin), eb = errorInCoverage(*b, range, bin);
             changes.push_back(paper ? change(eb.paper, ea.paper) : change(eb.plain, ea.plain));
           }
-        if (changes.size() < 2) return "";
-        double mean = 0.0, ss = 0.0;
-        for (double x : changes) mean += x;
-        mean /= static_cast<double>(changes.size());
-        for (double x : changes) ss += (x - mean) * (x - mean);
-        const double n = static_cast<double>(changes.size());
-        return fmt(" (± %.1f)", std::sqrt(ss / (n - 1.0) / n));
+        const double se = spread(changes).standardError();
+        return std::isnan(se) ? std::string() : fmt(" (± %.1f)", se);
       };
       // The sites where NDT falls short within this LiDAR's coverage (Table I's NDT only, the paper's
       // metric, over the trials), pooled: the paper's locations, where its figures were measured.
