@@ -72,7 +72,10 @@ class NdtPoseSource {
   ~NdtPoseSource();
 
   /// `scan` in the LiDAR frame, `predicted` the vehicle pose the filter predicts for `stamp`, `vx` and
-  /// `wz` its twist (for deskewing). Never throws for bad scans: the outcome says what happened.
+  /// `wz` its twist (for deskewing). NDT starts from `predicted` taken to 5 mm and 0.25 mrad, and
+  /// deskews with the twist taken to 1 mm/s and 1e-5 rad/s (docs/ndt.md: below NDT's own stop, so
+  /// that callers agreeing that closely share a match). Never throws for bad scans: the outcome says
+  /// what happened.
   ScanOutcome process(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
   /// The same for a scan shared with other sources (replays of one log): with an AlignmentMemo, asked of it.
   ScanOutcome process(const std::shared_ptr<const PointCloud>& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
