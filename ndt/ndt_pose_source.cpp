@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <string>
 
 #include "coloc/ndt/alignment_memo.hpp"
 
@@ -32,8 +33,15 @@ constexpr double kGuessStep = 5e-3, kGuessAngleStep = 2.5e-4;
 
 double roundedTo(double value, double step) { return std::isfinite(value) ? std::round(value / step) * step : value; }
 
+// Why `predicted` is no pose to start from, or empty.
+std::string notAPose(const Pose& predicted) {
+  if (!predicted.position.allFinite()) return "the predicted position is not finite";
+  if (!predicted.orientation.coeffs().allFinite()) return "the predicted orientation is not finite";
+  if (!(predicted.orientation.norm() > 1e-9)) return "the predicted orientation is a quaternion of no length";
+  return {};
+}
+
 Pose roundedGuess(const Pose& predicted) {
-  if (!predicted.position.allFinite() || !predicted.orientation.coeffs().allFinite()) return predicted;  // the aligner says why
   Pose out;
   for (int i = 0; i < 3; ++i) out.position[i] = roundedTo(predicted.position[i], kGuessStep);
   const Eigen::Vector3d rpy = rollPitchYaw(predicted.orientation.normalized());
@@ -69,10 +77,16 @@ ScanOutcome NdtPoseSource::process(const std::shared_ptr<const PointCloud>& scan
 
 ScanOutcome NdtPoseSource::process(const PointCloud& scan, const std::shared_ptr<const PointCloud>* shared, Stamp stamp, const Pose& prediction,
                                    double vx, double wz) {
+  ++counters_.scans;
+  if (const std::string why = notAPose(prediction); !why.empty()) {
+    ++counters_.bad_prediction;
+    ScanOutcome out;
+    out.detail = why;
+    return out;
+  }
   const Pose predicted = roundedGuess(prediction);
   vx = roundedTo(vx, kDeskewSpeedStep);
   wz = roundedTo(wz, kDeskewYawRateStep);
-  ++counters_.scans;
   // The map moves with the prediction whether or not the outcome is shared: its state is this source's.
   map_.update(predicted.position.head<2>());
   const auto target = map_.target();

@@ -40,6 +40,7 @@ std::string ndtJson(const ndt::NdtPoseSourceCounters& n, const ndt::DynamicMapSt
                                     {"poses", n.poses},
                                     {"scans_without_guess", scans_without_guess},
                                     {"no_map", n.no_map},
+                                    {"bad_prediction", n.bad_prediction},
                                     {"empty_scan", n.empty_scan},
                                     {"max_iterations", n.max_iterations},
                                     {"oscillation", n.oscillation},

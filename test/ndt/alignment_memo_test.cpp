@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 #include <stdexcept>
 #include <thread>
 
@@ -144,6 +146,34 @@ TEST(AlignmentMemo, PredictionsWithinTheGuesssRoundingAreOneQuestionAndAStepAway
   EXPECT_NE(again.alignment.transform, computed.alignment.transform);
   EXPECT_LT((again.pose.pose.position - computed.pose.pose.position).norm(), 1e-6);
   EXPECT_LT(again.pose.pose.orientation.angularDistance(computed.pose.pose.orientation), 1e-6);
+}
+
+// A prediction that is no pose (NaN or infinite position, a zero or NaN quaternion) is not rounded
+// into one: each gives no pose and says why, shared or not, and the source matches the next scan as
+// if they had not come.
+TEST(AlignmentMemo, APredictionThatIsNoPoseGivesNoPoseAndLeavesTheSourceAsItWas) {
+  const RealPair pair;
+  auto memo = std::make_shared<AlignmentMemo>();
+  NdtPoseSource shared = pair.source(memo), alone = pair.source(nullptr);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  std::vector<Pose> bad(4, pair.predicted);
+  bad[0].position.x() = nan;
+  bad[1].position.y() = inf;
+  bad[2].orientation = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.0);
+  bad[3].orientation = Eigen::Quaterniond(nan, 0.0, 0.0, 1.0);
+  for (std::size_t i = 0; i < bad.size(); ++i) {
+    for (NdtPoseSource* source : {&shared, &alone}) {
+      const ScanOutcome out = source == &shared ? source->process(pair.scan, 100, bad[i], 5.0, 0.1) : source->process(*pair.scan, 100, bad[i], 5.0, 0.1);
+      EXPECT_FALSE(out.produced) << "prediction " << i;
+      EXPECT_FALSE(out.detail.empty()) << "prediction " << i;
+    }
+  }
+  EXPECT_EQ(shared.counters().bad_prediction, 4u);
+  EXPECT_EQ(alone.counters().bad_prediction, 4u);
+  EXPECT_EQ(memo->stats().asked, 0u) << "nothing asked of the memo for them";
+  NdtPoseSource fresh = pair.source(nullptr);
+  expectSameOutcome(alone.process(*pair.scan, 100, pair.predicted, 5.0, 0.1), fresh.process(*pair.scan, 100, pair.predicted, 5.0, 0.1));
+  EXPECT_TRUE(shared.process(pair.scan, 100, pair.predicted, 5.0, 0.1).produced);
 }
 
 TEST(AlignmentMemo, AQuestionAskedTwiceAtOnceIsComputedOnce) {

@@ -31,6 +31,7 @@ struct NdtPoseSourceCounters {
   std::uint64_t shared = 0;           ///< outcomes taken from an AlignmentMemo, not computed here
   std::uint64_t poses = 0;            ///< accepted results handed on
   std::uint64_t no_map = 0;           ///< no tile near the predicted position
+  std::uint64_t bad_prediction = 0;   ///< a prediction that is no pose (not finite, or a quaternion of no length)
   std::uint64_t empty_scan = 0;       ///< nothing left after preprocessing
   std::uint64_t max_iterations = 0;
   std::uint64_t oscillation = 0;
@@ -74,8 +75,8 @@ class NdtPoseSource {
   /// `scan` in the LiDAR frame, `predicted` the vehicle pose the filter predicts for `stamp`, `vx` and
   /// `wz` its twist (for deskewing). NDT starts from `predicted` taken to 5 mm and 0.25 mrad, and
   /// deskews with the twist taken to 1 mm/s and 1e-5 rad/s (docs/ndt.md: below NDT's own stop, so
-  /// that callers agreeing that closely share a match). Never throws for bad scans: the outcome says
-  /// what happened.
+  /// that callers agreeing that closely share a match). Never throws for bad scans or a prediction
+  /// that is no pose: the outcome says what happened.
   ScanOutcome process(const PointCloud& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
   /// The same for a scan shared with other sources (replays of one log): with an AlignmentMemo, asked of it.
   ScanOutcome process(const std::shared_ptr<const PointCloud>& scan, Stamp stamp, const Pose& predicted, double vx, double wz);
