@@ -232,10 +232,14 @@ TEST_F(Station, ACarParkedSinceCommissioningBecomesBackgroundAfterAsManyLearnedF
   };
   const int every_frame = framesUntilLost(1), every_fourth = framesUntilLost(4);
   std::printf("a parked car becomes background after %d frames learning each, %d learning one in four\n", every_frame, every_fourth);
-  EXPECT_GE(every_frame, 3) << "not in the background before it has been in a few frames";
-  EXPECT_LE(every_frame, 10);
-  EXPECT_GE(every_fourth, 4 * every_frame - 4);
-  EXPECT_LE(every_fourth, 4 * every_frame + 4);
+  // A voxel the car returns from in every frame is background once it holds min_occupancy of the
+  // learned frames: 5 after the 20 commissioning ones (5 / 25). The car is lost once enough of its
+  // voxels are, which over ten seeds of the LiDAR's noise took 9-13 learned frames in either pass (the
+  // two passes draw different noise, so one is not a multiple of the other to the frame).
+  EXPECT_GE(every_frame, 5) << "not in the background before it has been in a few frames";
+  EXPECT_LE(every_frame, 15);
+  EXPECT_GE(every_fourth, 4 * 5) << "learning one frame in four, as many learned frames take four times as long";
+  EXPECT_LE(every_fourth, 4 * 15);
 }
 
 // A survey's frame of the empty street instead of commissioning frames: fixes from the first frames,
@@ -271,11 +275,14 @@ TEST_F(Station, CommissionedFromASurveyedEmptyFrameItFixesFromTheFirstFrames) {
 // the measures and, from five, places the box with them in the frames that do not; the same car, its CAM
 // sent again with another size, is measured afresh.
 TEST_F(Station, AVehicleWhoseCamOverstatesItsWidthIsPlacedWithTheWidthItsFramesMeasure) {
+  // Each pass's fixes apart: those placed with the CAM's size and those placed with a side the frames
+  // measured (the station's counter moving in that frame). One median over both would sit between
+  // the two groups, as many fixes of this drive come before the station has its measures.
   struct Pass {
-    std::vector<double> across;  ///< each fix's distance across the lane from the body's centre, m
-    int measured_from = -1;      ///< the first frame placed within 8 cm across
-    std::uint64_t counted = 0;   ///< fixes the station counts as placed with a measured side
-    double after_new_size = -1;  ///< across, the first fix after the CAM sent another size
+    std::vector<double> with_cam;       ///< each fix's distance across the lane from the body's centre, m
+    std::vector<double> with_measured;  ///< the same, for the fixes placed with a measured side
+    int measured_from = -1;             ///< the first frame placed with a measured side
+    double after_new_size = -1;         ///< across, the first fix after the CAM sent another size
   };
   const auto pass = [&](bool measure, bool each_frame) {
     RsuStationConfig config;
@@ -293,6 +300,7 @@ TEST_F(Station, AVehicleWhoseCamOverstatesItsWidthIsPlacedWithTheWidthItsFramesM
       v.width = std::round((car_.width + (k < 50 ? 0.4 : 0.5)) * 10.0) / 10.0;  // from frame 50 another size
       v.length = std::round((car_.length + 0.1) * 10.0) / 10.0;
       station.addVehicle(v);
+      const std::uint64_t counted_before = station.counters().fixes_with_measured_size;
       for (const StationOutcome& o : station.frame(frame(), fromSeconds(10.0 + t))) {
         if (!o.detection.found) continue;
         const double across = std::abs(o.detection.position.y() - car.y);
@@ -300,34 +308,33 @@ TEST_F(Station, AVehicleWhoseCamOverstatesItsWidthIsPlacedWithTheWidthItsFramesM
           if (out.after_new_size < 0.0) out.after_new_size = across;
           continue;
         }
-        out.across.push_back(across);
-        if (out.measured_from < 0 && across < 0.08) out.measured_from = k;
+        const bool with_measured = station.counters().fixes_with_measured_size > counted_before;
+        (with_measured ? out.with_measured : out.with_cam).push_back(across);
+        if (with_measured && out.measured_from < 0) out.measured_from = k;
       }
     }
-    out.counted = station.counters().fixes_with_measured_size;
+    for (std::vector<double>* v : {&out.with_cam, &out.with_measured}) std::sort(v->begin(), v->end());
     return out;
   };
-  Pass cam_size = pass(false, false), learned = pass(true, false), measured = pass(true, true);
-  for (Pass* p : {&cam_size, &learned, &measured}) {
-    ASSERT_GE(p->across.size(), 20u);
-    std::sort(p->across.begin(), p->across.end());
-  }
-  const auto median = [](const Pass& p) { return p.across[p.across.size() / 2]; };
-  std::printf("across the lane, median: the CAM's width %.3f m (%zu fixes); measured over the frames %.3f m (%zu fixes, from frame %d, "
-              "%llu counted), the first fix after another size %.3f m; and in each frame %.3f m (%zu fixes, from frame %d, %llu counted), "
-              "after another size %.3f m\n",
-              median(cam_size), cam_size.across.size(), median(learned), learned.across.size(), learned.measured_from,
-              (unsigned long long)learned.counted, learned.after_new_size, median(measured), measured.across.size(), measured.measured_from,
-              (unsigned long long)measured.counted, measured.after_new_size);
-  EXPECT_GT(median(cam_size), 0.12) << "the CAM's 0.36 m excess shows across the lane";
-  EXPECT_EQ(cam_size.counted, 0u);
+  const auto median = [](const std::vector<double>& v) { return v.empty() ? -1.0 : v[v.size() / 2]; };
+  const Pass cam_size = pass(false, false), learned = pass(true, false), measured = pass(true, true);
+  for (const auto& [name, p] : {std::pair{"the CAM's width", &cam_size}, {"measured over the frames", &learned}, {"measured in each frame", &measured}})
+    std::printf("%s: %zu fixes with the CAM's size (median across the lane %.3f m), %zu with a measured side (median %.3f m, from frame %d); "
+                "the first fix after another size %.3f m\n",
+                name, p->with_cam.size(), median(p->with_cam), p->with_measured.size(), median(p->with_measured), p->measured_from,
+                p->after_new_size);
+  ASSERT_GE(cam_size.with_cam.size(), 20u);
+  EXPECT_TRUE(cam_size.with_measured.empty());
+  EXPECT_GT(median(cam_size.with_cam), 0.12) << "the CAM's 0.36 m excess shows across the lane";
+  // Over ten seeds of the LiDAR's noise: 19-27 fixes placed with a measured side, their median 0.5-1.8 cm
+  // across the lane (the CAM's size puts it 18 cm off).
   for (const Pass* p : {&learned, &measured}) {
-    EXPECT_LT(median(*p), 0.06);
-    EXPECT_GE(p->counted, p->across.size() / 2) << "the fixes placed with the width measured are counted";
+    EXPECT_GE(p->with_measured.size(), 15u) << "the fixes placed with the width measured are counted";
+    EXPECT_LT(median(p->with_measured), 0.03);
     ASSERT_GE(p->after_new_size, 0.0) << "no fix after the CAM's new size";
   }
   // Each frame's own measure places the box from the first frame that sees the front whole; the
-  // station's, from the fifth.
+  // station's, once it has min_measures of them.
   EXPECT_LT(measured.measured_from, learned.measured_from);
   // Another size in the CAM: the station's measures start afresh, its first fix placed with the new
   // CAM's; the frame's own measure still places it.
