@@ -50,7 +50,11 @@ std::optional<GroundPlane> fitGroundPlane(const std::vector<Eigen::Vector3d>& po
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());  // a fixed order: the same frames give the same plane
   });
   // RANSAC over triples for the plane most cells lie on (a canopy or a roof over some cells, walls'
-  // lowest returns above their foot), then least squares over its cells, twice.
+  // lowest returns above their foot), then least squares over the cells weighted by a Cauchy function
+  // of their residual, to convergence. A hard inlier band instead (the plane refit over the cells
+  // within it) flips which cells count where the road's own swell is about the band's width: on a
+  // crowned road with a 0.25 m swell (test RoadSurface.TheLocalRoad*) the tilt came out 3.00-3.16 or
+  // 3.33-3.39 deg by the LiDAR's noise; weighted, 3.105-3.118 deg over ten seeds.
   std::mt19937 rng(7);
   std::uniform_int_distribution<std::size_t> pick(0, low.size() - 1);
   const double inlier = 0.2;  // m: the road's own unevenness within a plane
@@ -69,13 +73,20 @@ std::optional<GroundPlane> fitGroundPlane(const std::vector<Eigen::Vector3d>& po
     if (count > best_count) best_count = count, best = *abc;
   }
   if (best_count < 10) return std::nullopt;
-  for (int round = 0; round < 2; ++round) {
-    for (std::size_t i = 0; i < low.size(); ++i)
-      w[i] = std::abs(low[i].z() - (best[0] + best[1] * low[i].x() + best[2] * low[i].y())) <= inlier ? 1.0 : 0.0;
+  for (int round = 0; round < 30; ++round) {
+    for (std::size_t i = 0; i < low.size(); ++i) {
+      const double r = std::abs(low[i].z() - (best[0] + best[1] * low[i].x() + best[2] * low[i].y())) / inlier;
+      w[i] = r <= 3.0 ? 1.0 / (1.0 + r * r) : 0.0;
+    }
     const auto refined = planeThrough(low, w);
     if (!refined) break;
+    const bool settled = (*refined - best).cwiseAbs().maxCoeff() < 1e-9;
     best = *refined;
+    if (settled) break;
   }
+  // The cells within the band are the plane's: its rms and count.
+  for (std::size_t i = 0; i < low.size(); ++i)
+    w[i] = std::abs(low[i].z() - (best[0] + best[1] * low[i].x() + best[2] * low[i].y())) <= inlier ? 1.0 : 0.0;
   GroundPlane g{best[0], best[1], best[2], 0, 0.0};
   double sum_sq = 0.0;
   for (std::size_t i = 0; i < low.size(); ++i)
