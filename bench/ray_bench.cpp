@@ -1,8 +1,8 @@
 // Ray casting of the twin: rays per second of RayCaster::cast (packets of 8 on every core) against
 // castOneByOne (one ray at a time on one thread, the reference), in the same run, on a street of
 // houses, trees and cars seen by a 32-beam LiDAR sweep (57,600 rays). And the sweep's noise: the points
-// sim::sweepPoints makes of those hits (range noise and dropouts, two draws per ray) against the same
-// loop on the standard library's engine and distributions, which give the same draws (one thread); and
+// sim::sweepPoints makes of those hits (range noise and dropouts, each ray's own draws) against the same
+// loop on the standard library's engine and distributions, two draws per ray in ray order (one thread); and
 // the twin's engine against std::mt19937_64, which gives the same numbers, a million numbers at a time.
 #include <benchmark/benchmark.h>
 

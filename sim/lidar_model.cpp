@@ -8,6 +8,7 @@
 
 #include "coloc/core/error.hpp"
 #include "coloc/sim/error_sources.hpp"
+#include "coloc/sim/ray_noise.hpp"
 
 namespace coloc::sim {
 
@@ -100,35 +101,6 @@ std::shared_ptr<const Directions> localDirections(const LidarSpec& spec, int fir
   cache.push_back({spec.vertical_deg, spec.azimuth_offset_deg, spec.azimuth_step_deg, directions});
   return directions;
 }
-
-// Standard normal draws by Marsaglia's polar method, a pair from each accepted point of the unit disc:
-// the values, in the order, that std::normal_distribution<double> gives with libstdc++ (the second of
-// the pair first), on every standard library. A pair's scale, a log and a square root, is computed only
-// when one of its values is used: a ray into the sky draws its noise like any other, so that each
-// ray's noise does not depend on what the others hit, but needs no value.
-class PolarPairs {
- public:
-  /// The next draw: the second of a new pair, or the first of the current one.
-  void draw(RandomEngine& rng) {
-    first_ = !first_;
-    if (!first_) return;
-    do {
-      x_ = 2.0 * rng.canonical() - 1.0;
-      y_ = 2.0 * rng.canonical() - 1.0;
-      r2_ = x_ * x_ + y_ * y_;
-    } while (r2_ > 1.0 || r2_ == 0.0);
-    scale_ = -1.0;
-  }
-  /// The last draw's value.
-  double value() {
-    if (scale_ < 0.0) scale_ = std::sqrt(-2.0 * std::log(r2_) / r2_);
-    return (first_ ? y_ : x_) * scale_;
-  }
-
- private:
-  bool first_ = false;  ///< the last draw began a pair
-  double x_ = 0.0, y_ = 0.0, r2_ = 1.0, scale_ = 0.0;
-};
 
 // What a footprint of three equal parts returns: samples within `separation` of each other make one
 // echo at their mean range (mixed pixels), and the echo returned is the strongest, the share of the
@@ -348,20 +320,18 @@ void sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomE
   const std::shared_ptr<const Directions> table = localDirections(spec, firings);
   const std::vector<Eigen::Vector3f>& local = table->rounded;
   const bool dropouts = spec.dropout > 0.0 || spec.dropout_at_max_range > 0.0;
-  PolarPairs noise;
+  // One draw of the drive's engine per sweep; each ray's draws are then its own (ray_noise.hpp).
+  const RayNoise noise(rng());
   points.clear();
   points.reserve(hits.size());  // a sweep hits more than half its rays outdoors: no second allocation and copy
   for (int f = 0; f < firings; ++f) {
     const float time = static_cast<float>(sweep * f / firings);
     for (int l = 0; l < lasers; ++l) {
       const std::size_t i = static_cast<std::size_t>(f * lasers + l);
-      // The same draws per ray, hit or not, so that the noise of a point does not depend on the others.
-      noise.draw(rng);
-      const double u = dropouts ? rng.canonical() : 1.0;
       if (hits[i].distance < 0.0f) continue;
       const double r = hits[i].distance;
-      if (dropouts && u < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
-      const double range = r + noise.value() * (spec.range_noise + spec.range_noise_per_m * r);
+      if (dropouts && noise.uniform(i) < spec.dropout + spec.dropout_at_max_range * (r / spec.max_range) * (r / spec.max_range)) continue;
+      const double range = r + noise.normal(i) * (spec.range_noise + spec.range_noise_per_m * r);
       if (range < spec.min_range || range > spec.max_range) continue;
       points.push_back({static_cast<float>(range) * local[i], time, l, hits[i].mesh});
     }

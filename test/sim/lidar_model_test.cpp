@@ -5,7 +5,6 @@
 #include <random>
 
 #include "coloc/sim/lidar_model.hpp"
-#include "standard_sweep.hpp"
 
 namespace coloc::sim {
 namespace {
@@ -215,45 +214,41 @@ TEST(LidarModel, AFootprintUnderAnEdgeAboveReturnsTheStrongerEchoOrAMixedRange) 
   EXPECT_NEAR(castSweep(spec, wall, [](double) { return Eigen::Isometry3d::Identity(); })[1].distance, 39.9, 1e-4);
 }
 
-#if defined(__GLIBCXX__)
-// The twin's results were made with libstdc++'s std::normal_distribution and uniform draws, two per ray
-// in ray order, hit or not; the sweep's own draws (whose log is skipped for rays that return nothing)
-// must give every point the very range those gave.
-TEST(LidarModel, SweepNoiseIsTheStandardDrawsPerRayWhateverTheRaysHit) {
+// Each ray's noise is its own: the same sweep key gives a ray the same range whatever the other rays
+// hit (so a ray into the sky changes nothing for the rest), and a sweep takes one draw of the engine.
+TEST(LidarModel, ARaysNoiseAndDropoutAreItsOwnWhateverTheOtherRaysHit) {
   LidarSpec spec = vlp32c();
   spec.range_noise = 0.02;
   spec.range_noise_per_m = 0.0005;
   spec.dropout = 0.05;
   spec.dropout_at_max_range = 0.3;
   const std::size_t rays = static_cast<std::size_t>(firingsPerSweep(spec)) * spec.vertical_deg.size();
-  // Hits and misses in runs and alone, so that pairs of draws fall on two misses, two hits and one of each.
   std::mt19937 pattern(5);
   std::uniform_real_distribution<float> distance(0.5f, 110.0f);
-  std::vector<RayHit> hits(rays);
-  for (std::size_t i = 0; i < rays; ++i)
-    if ((i / 7) % 3 != 0 && pattern() % 5 != 0) hits[i] = {distance(pattern), static_cast<int>(i % 4)};
-  // The reference: the standard distributions on std::mt19937_64, each kept point's range written back
-  // as a hit, which a sweep without noise or dropouts turns into the same point.
-  std::mt19937_64 reference(99);
-  std::vector<RayHit> kept;
-  coloc::testing::standardSweepRanges(spec, hits, reference, kept);
-  LidarSpec exact = spec;
-  exact.range_noise = exact.range_noise_per_m = exact.dropout = exact.dropout_at_max_range = 0.0;
-  exact.min_range = 0.0;
-  RandomEngine engine(99), unused(1);
-  const std::vector<LidarPoint> noisy = sweepPoints(spec, hits, engine), expected = sweepPoints(exact, kept, unused);
-  ASSERT_EQ(noisy.size(), expected.size());
-  ASSERT_GT(noisy.size(), rays / 3);
-  for (std::size_t i = 0; i < noisy.size(); ++i) {
-    ASSERT_EQ(noisy[i].position, expected[i].position) << "point " << i;
-    ASSERT_EQ(noisy[i].time, expected[i].time);
-    ASSERT_EQ(noisy[i].laser, expected[i].laser);
-    ASSERT_EQ(noisy[i].mesh, expected[i].mesh);
+  std::vector<RayHit> all(rays), some(rays);
+  for (std::size_t i = 0; i < rays; ++i) {
+    all[i] = {distance(pattern), static_cast<int>(i % 4)};
+    if ((i / 7) % 3 != 0 && pattern() % 5 != 0) some[i] = all[i];  // misses in runs and alone
   }
-  // And the sweep took exactly the draws the reference took.
-  EXPECT_EQ(engine(), reference());
+  RandomEngine a(99), b(99), reference(99);
+  const std::vector<LidarPoint> from_all = sweepPoints(spec, all, a), from_some = sweepPoints(spec, some, b);
+  std::map<std::pair<int, float>, Eigen::Vector3f> by_ray;
+  for (const LidarPoint& p : from_all) by_ray[{p.laser, p.time}] = p.position;
+  ASSERT_GT(from_some.size(), rays / 3);
+  std::size_t dropped = 0;
+  for (const LidarPoint& p : from_some) {
+    const auto found = by_ray.find({p.laser, p.time});
+    ASSERT_NE(found, by_ray.end()) << "a ray kept with fewer neighbours hitting was dropped with more";
+    EXPECT_EQ(found->second, p.position);
+  }
+  for (std::size_t i = 0; i < rays; ++i) dropped += some[i].distance >= 0.0f ? 1 : 0;
+  dropped -= from_some.size();
+  EXPECT_GT(dropped, 0u) << "the spec's dropouts were drawn";
+  reference();  // the sweep's key
+  const RandomEngine::result_type next = reference();
+  EXPECT_EQ(a(), next) << "one draw of the engine per sweep";
+  EXPECT_EQ(b(), next) << "one draw of the engine per sweep";
 }
-#endif
 
 }  // namespace
 }  // namespace coloc::sim

@@ -1,7 +1,7 @@
 #pragma once
 // A sweep's noise and dropouts drawn as the twin drew them before it had its own engine: per ray, hit or
-// not, a std::normal_distribution and a std::uniform_real_distribution draw on std::mt19937_64. The
-// reference sim::sweepPoints is pinned to (test) and measured against (ray_bench).
+// not, a std::normal_distribution and a std::uniform_real_distribution draw on std::mt19937_64: the
+// baseline ray_bench measures sim::sweepPoints against (the same noise's distribution, not its draws).
 #include <random>
 #include <vector>
 

@@ -69,8 +69,8 @@ std::vector<LidarPoint> scanSweep(const LidarSpec& spec, const RayCaster& world,
 std::vector<RayHit> castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose);
 /// (into `hits`, its room kept from sweep to sweep: fresh room costs page faults)
 void castSweep(const LidarSpec& spec, const RayCaster& world, const SensorTrajectory& pose, std::vector<RayHit>& hits);
-/// ...and the points those hits give with the spec's noise and dropouts drawn from `rng` (two draws per
-/// ray, hit or not). Throws coloc::Error if `hits` is not a sweep of this spec.
+/// ...and the points those hits give with the spec's noise and dropouts: one draw of `rng` per sweep,
+/// each ray's own draws from it (ray_noise.hpp). Throws coloc::Error if `hits` is not a sweep of this spec.
 std::vector<LidarPoint> sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng);
 /// The same into `points` (its room kept: a loop over sweeps then allocates once).
 void sweepPoints(const LidarSpec& spec, const std::vector<RayHit>& hits, RandomEngine& rng, std::vector<LidarPoint>& points);
