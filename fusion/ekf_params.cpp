@@ -43,6 +43,10 @@ const std::vector<EkfParam>& ekfParams() {
       {"map_error_sd", "m", "the map's own error against the world (its survey's accuracy, per axis): added to the reported x/y covariance, not the filter's; 0 = the map is the world", &C::map_error_sd},
       {"map_match_bias_sd", "m", "a bias NDT's poses share from scan to scan (the map's, the place's), as two more states: its stationary sd; the roadside fixes (anchors) tell it apart; 0 = not modelled (Autoware's 6 states)", &C::map_match_bias_sd},
       {"map_match_bias_length", "m", "travel over which that bias fades to 1/e (a random walk in distance)", &C::map_match_bias_length},
+      {"odometry_scale_sd", "", "the odometry's speed scale error as a state (the twist measures (1 + scale) vx), learned from the poses: its initial sd; 0 = not modelled (unless odometry_yaw_rate_bias_sd is)", &C::odometry_scale_sd},
+      {"odometry_scale_walk", "1/sqrt(m)", "that error's random walk in distance", &C::odometry_scale_walk},
+      {"odometry_yaw_rate_bias_sd", "rad/s", "the gyro's bias as a state (the twist measures wz + bias), learned from the poses: its initial sd; 0 = not modelled (unless odometry_scale_sd is)", &C::odometry_yaw_rate_bias_sd},
+      {"odometry_yaw_rate_bias_walk", "rad/s/sqrt(s)", "that bias's random walk in time", &C::odometry_yaw_rate_bias_walk},
   };
   return params;
 }

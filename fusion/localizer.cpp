@@ -48,9 +48,14 @@ void validate(const EkfConfig& c) {
       {"integrity_lost_min_distance", c.integrity_lost_min_distance},
       {"integrity_dead_reckoning_limit", c.integrity_dead_reckoning_limit},
       {"integrity_anchor_memory", c.integrity_anchor_memory},
-      {"map_error_sd", c.map_error_sd},                 {"map_match_bias_sd", c.map_match_bias_sd}};
+      {"map_error_sd", c.map_error_sd},                 {"map_match_bias_sd", c.map_match_bias_sd},
+      {"odometry_scale_sd", c.odometry_scale_sd},       {"odometry_scale_walk", c.odometry_scale_walk},
+      {"odometry_yaw_rate_bias_sd", c.odometry_yaw_rate_bias_sd},
+      {"odometry_yaw_rate_bias_walk", c.odometry_yaw_rate_bias_walk}};
   for (const auto& [key, value] : non_negative) requireConfig(std::isfinite(value) && value >= 0.0, key, "must be finite and >= 0");
   requireConfig(std::isfinite(c.map_match_bias_length) && c.map_match_bias_length > 0.0, "map_match_bias_length", "must be finite and > 0");
+  requireConfig(c.odometry_scale_sd <= 0.5, "odometry_scale_sd", "must be at most 0.5 (a wheel half as large again)");
+  requireConfig(c.odometry_yaw_rate_bias_sd <= 1.0, "odometry_yaw_rate_bias_sd", "must be at most 1 rad/s");
   requireConfig(std::isfinite(c.initial_vx_variance) && c.initial_vx_variance > 0.0, "initial_vx_variance", "must be finite and > 0");
   requireConfig(std::isfinite(c.initial_wz_variance) && c.initial_wz_variance > 0.0, "initial_wz_variance", "must be finite and > 0");
 }
@@ -62,7 +67,9 @@ HistoryOptions historyOptions(const EkfConfig& c) {
   o.noise = {c.proc_stddev_yaw_c, c.proc_stddev_vx_c, c.proc_stddev_wz_c};
   o.aux_proc_dev = {c.z_filter_proc_dev, c.roll_filter_proc_dev, c.pitch_filter_proc_dev};
   o.relinearize = c.relinearize_on_replay;
-  o.bias_length = c.map_match_bias_length;
+  o.extra.bias_length = c.map_match_bias_length;
+  o.extra.scale_walk = c.odometry_scale_walk;
+  o.extra.gyro_bias_walk = c.odometry_yaw_rate_bias_walk;
   return o;
 }
 
@@ -305,15 +312,23 @@ struct Localizer::Impl {
       // the position only as well as the pose and the bias together, and knows their sum exactly as
       // well as the pose: x = z - b, so x and b start anti-correlated.
       const double variance = history.biasVariance();
-      s.bias.modelled = true;
-      s.bias.P = Eigen::Matrix2d::Identity() * variance;
+      s.extra.bias_modelled = true;
+      s.extra.P.topLeftCorner<2, 2>() = Eigen::Matrix2d::Identity() * variance;
       for (int i = 0; i < r.m && r.biased; ++i) {
         const int si = r.index[i];
         if (si != kX && si != kY) continue;
-        s.x[si] -= s.bias.b[si];
+        const int bi = si == kX ? ExtraStates::kBiasX : ExtraStates::kBiasY;
+        s.x[si] -= s.extra.v[bi];
         s.P(si, si) += variance;
-        s.bias.cross(si, si) = -variance;
+        s.extra.cross(si, bi) = -variance;
       }
+    }
+    if (config.odometry_scale_sd > 0.0 || config.odometry_yaw_rate_bias_sd > 0.0) {
+      // The odometry's errors start unknown but for their spread: what a start learned is not kept
+      // (a recovery starts afresh, as the pipeline's own learners do).
+      s.extra.odometry_modelled = true;
+      s.extra.P(ExtraStates::kScale, ExtraStates::kScale) = config.odometry_scale_sd * config.odometry_scale_sd;
+      s.extra.P(ExtraStates::kGyroBias, ExtraStates::kGyroBias) = config.odometry_yaw_rate_bias_sd * config.odometry_yaw_rate_bias_sd;
     }
     return s;
   }
@@ -447,7 +462,7 @@ struct Localizer::Impl {
     const double vx = s.x[kVx];
     s.x = predictState(s.x, dt, A);
     s.P = propagateCovariance(A, s.P, processNoise(history.options().noise, dt));
-    if (s.bias.modelled) propagateBias(s.bias, A, vx, dt, history.options().bias_length, history.biasVariance());
+    if (s.extra.any()) propagateExtra(s.extra, A, vx, dt, history.options().extra);
     predictAux(s, history.options().aux_proc_dev, dt);
     return describe(s, stamp);
   }
@@ -459,7 +474,12 @@ struct Localizer::Impl {
     e.state = s.x;
     e.state_covariance = s.P;
     e.yaw_bias = s.x[kYawBias];
-    if (s.bias.modelled) e.map_match_bias = s.bias.b, e.map_match_bias_covariance = s.bias.P;
+    if (s.extra.bias_modelled) e.map_match_bias = s.extra.bias(), e.map_match_bias_covariance = s.extra.biasCovariance();
+    if (s.extra.odometry_modelled) {
+      e.odometry_scale_error = s.extra.v[ExtraStates::kScale];
+      e.odometry_yaw_rate_bias = s.extra.v[ExtraStates::kGyroBias];
+      e.odometry_error_covariance = s.extra.P.bottomRightCorner<2, 2>();
+    }
     const double z = s.aux[kAuxZ].initialized ? s.aux[kAuxZ].value : 0.0;
     const double roll = s.aux[kAuxRoll].initialized ? s.aux[kAuxRoll].value : 0.0;
     const double pitch = s.aux[kAuxPitch].initialized ? s.aux[kAuxPitch].value : 0.0;

@@ -63,8 +63,8 @@ void updateAux(ScalarFilter& filter, double value, double variance, bool angle) 
 // at vx; yaw at wz).
 struct Model {
   Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
-  Eigen::Matrix<double, 3, 2> Hb = Eigen::Matrix<double, 3, 2>::Zero();  ///< on the map-matching bias
-  bool with_bias = false;  ///< the state models the bias: the update runs on all eight states
+  Eigen::Matrix<double, 3, 4> He = Eigen::Matrix<double, 3, 4>::Zero();  ///< on the extra states
+  bool with_extra = false;  ///< the state models extra states: the update runs on all ten
   Eigen::Vector3d predicted = Eigen::Vector3d::Zero();
 };
 
@@ -72,14 +72,26 @@ Model model(const FilterState& state, const UpdateRecord& record) {
   Model out;
   const double dt = record.time_offset, heading = state.x[kYaw] + state.x[kYawBias], vx = state.x[kVx];
   const double c = std::cos(heading), s = std::sin(heading);
-  out.with_bias = state.bias.modelled;
+  const ExtraStates& extra = state.extra;
+  out.with_extra = extra.any();
   for (int i = 0; i < record.m; ++i) {
     const int si = record.index[i];
     out.H(i, si) = 1.0;
     out.predicted[i] = state.x[si];
-    if (out.with_bias && record.biased && (si == kX || si == kY)) {
-      out.Hb(i, si) = 1.0;
-      out.predicted[i] += state.bias.b[si];
+    if (extra.bias_modelled && record.biased && (si == kX || si == kY)) {
+      out.He(i, si == kX ? ExtraStates::kBiasX : ExtraStates::kBiasY) = 1.0;
+      out.predicted[i] += extra.v[si == kX ? ExtraStates::kBiasX : ExtraStates::kBiasY];
+    }
+    // The odometry measures (1 + scale) vx and wz + its gyro's bias.
+    if (extra.odometry_modelled && si == kVx) {
+      const double scale = extra.v[ExtraStates::kScale];
+      out.H(i, kVx) = 1.0 + scale;
+      out.He(i, ExtraStates::kScale) = state.x[kVx];
+      out.predicted[i] = (1.0 + scale) * state.x[kVx];
+    }
+    if (extra.odometry_modelled && si == kWz) {
+      out.He(i, ExtraStates::kGyroBias) = 1.0;
+      out.predicted[i] += extra.v[ExtraStates::kGyroBias];
     }
     if (dt == 0.0) continue;
     if (si == kX || si == kY) {
@@ -100,9 +112,9 @@ Innovation innovationWith(const FilterState& state, const UpdateRecord& record, 
   Innovation out;
   out.m = record.m;
   Eigen::Matrix<double, 3, 3> HPHt = mdl.H * state.P * mdl.H.transpose();
-  if (mdl.with_bias) {
-    const Eigen::Matrix<double, 3, 3> HCHb = mdl.H * state.bias.cross * mdl.Hb.transpose();
-    HPHt += HCHb + HCHb.transpose() + mdl.Hb * state.bias.P * mdl.Hb.transpose();
+  if (mdl.with_extra) {
+    const Eigen::Matrix<double, 3, 3> HCHe = mdl.H * state.extra.cross * mdl.He.transpose();
+    HPHt += HCHe + HCHe.transpose() + mdl.He * state.extra.P * mdl.He.transpose();
   }
   for (int i = 0; i < record.m; ++i) {
     const int si = record.index[i];
@@ -113,24 +125,24 @@ Innovation innovationWith(const FilterState& state, const UpdateRecord& record, 
   return out;
 }
 
-// The update on all eight states, the six and the bias as blocks: P H^T, the gain and the downdate
-// of each block, the same Kalman update as applyUpdate's on the six.
-bool applyWithBias(FilterState& state, const Model& mdl, const Innovation& in) {
-  MapMatchBias& bias = state.bias;
-  Eigen::Matrix<double, 8, 3> PHt;
-  PHt.topRows<6>() = state.P * mdl.H.transpose() + bias.cross * mdl.Hb.transpose();
-  PHt.bottomRows<2>() = bias.cross.transpose() * mdl.H.transpose() + bias.P * mdl.Hb.transpose();
-  Eigen::Matrix<double, 3, 8> KT = Eigen::Matrix<double, 3, 8>::Zero();
-  if (!solveSpd<8>(in.S, in.m, PHt.transpose(), KT)) return false;
-  const Eigen::Matrix<double, 8, 3> K = KT.transpose();
+// The update on all ten states, the six and the extra ones as blocks: P H^T, the gain and the
+// downdate of each block, the same Kalman update as applyUpdate's on the six.
+bool applyWithExtra(FilterState& state, const Model& mdl, const Innovation& in) {
+  ExtraStates& extra = state.extra;
+  Eigen::Matrix<double, 10, 3> PHt;
+  PHt.topRows<6>() = state.P * mdl.H.transpose() + extra.cross * mdl.He.transpose();
+  PHt.bottomRows<4>() = extra.cross.transpose() * mdl.H.transpose() + extra.P * mdl.He.transpose();
+  Eigen::Matrix<double, 3, 10> KT = Eigen::Matrix<double, 3, 10>::Zero();
+  if (!solveSpd<10>(in.S, in.m, PHt.transpose(), KT)) return false;
+  const Eigen::Matrix<double, 10, 3> K = KT.transpose();
   state.x += K.topRows<6>() * in.e;
   state.x[kYaw] = wrapAngle(state.x[kYaw]);
-  bias.b += K.bottomRows<2>() * in.e;
+  extra.v += K.bottomRows<4>() * in.e;
   state.P -= K.topRows<6>() * PHt.topRows<6>().transpose();
   state.P = 0.5 * (state.P + state.P.transpose());
-  bias.cross -= K.topRows<6>() * PHt.bottomRows<2>().transpose();
-  bias.P -= K.bottomRows<2>() * PHt.bottomRows<2>().transpose();
-  bias.P = 0.5 * (bias.P + bias.P.transpose());
+  extra.cross -= K.topRows<6>() * PHt.bottomRows<4>().transpose();
+  extra.P -= K.bottomRows<4>() * PHt.bottomRows<4>().transpose();
+  extra.P = 0.5 * (extra.P + extra.P.transpose());
   return true;
 }
 
@@ -194,8 +206,8 @@ bool applyUpdate(FilterState& state, const UpdateRecord& record) {
   if (record.m > 0) {
     const Model mdl = model(state, record);
     const Innovation in = innovationWith(state, record, mdl, record.scale);
-    if (mdl.with_bias) {
-      if (!applyWithBias(state, mdl, in)) return false;
+    if (mdl.with_extra) {
+      if (!applyWithExtra(state, mdl, in)) return false;
     } else {
       // PHt = P H^T (rows of H beyond m are zero).
       const Eigen::Matrix<double, 6, 3> PHt = state.P * mdl.H.transpose();

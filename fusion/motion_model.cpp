@@ -63,12 +63,22 @@ Matrix6d propagateCovariance(const Matrix6d& A, const Matrix6d& P, const Matrix6
   return 0.5 * (next + next.transpose());
 }
 
-void propagateBias(MapMatchBias& bias, const Matrix6d& A, double vx, double dt, double length, double variance) {
-  const double phi = std::exp(-std::abs(vx) * dt / length);
-  bias.b *= phi;
-  bias.cross = phi * (A * bias.cross);
-  bias.P = phi * phi * bias.P;
-  bias.P.diagonal().array() += (1.0 - phi * phi) * variance;
+void propagateExtra(ExtraStates& extra, const Matrix6d& A, double vx, double dt, const ExtraNoise& noise) {
+  extra.cross = A * extra.cross;
+  if (extra.bias_modelled) {
+    const double phi = std::exp(-std::abs(vx) * dt / noise.bias_length);
+    extra.v.head<2>() *= phi;
+    extra.cross.leftCols<2>() *= phi;
+    extra.P.topLeftCorner<2, 2>() = phi * phi * extra.P.topLeftCorner<2, 2>();
+    extra.P.topRightCorner<2, 2>() *= phi;
+    extra.P.bottomLeftCorner<2, 2>() *= phi;
+    extra.P(ExtraStates::kBiasX, ExtraStates::kBiasX) += (1.0 - phi * phi) * noise.bias_variance;
+    extra.P(ExtraStates::kBiasY, ExtraStates::kBiasY) += (1.0 - phi * phi) * noise.bias_variance;
+  }
+  if (extra.odometry_modelled) {
+    extra.P(ExtraStates::kScale, ExtraStates::kScale) += noise.scale_walk * noise.scale_walk * std::abs(vx) * dt;
+    extra.P(ExtraStates::kGyroBias, ExtraStates::kGyroBias) += noise.gyro_bias_walk * noise.gyro_bias_walk * dt;
+  }
 }
 
 }  // namespace coloc::fusion

@@ -32,9 +32,20 @@ Matrix6d processNoise(const ProcessNoise& noise, double dt);
 /// which is what the product visits (half the multiplications of the dense one).
 Matrix6d propagateCovariance(const Matrix6d& A, const Matrix6d& P, const Matrix6d& Q);
 
-/// The map-matching bias over one step of dt at speed vx, a random walk in distance: it fades by
-/// phi = exp(-|vx| dt / length) and its covariance goes to phi^2 P + (1 - phi^2) variance I, which
-/// stays at `variance` once there; the six states' covariance with it is carried by A and phi.
-void propagateBias(MapMatchBias& bias, const Matrix6d& A, double vx, double dt, double length, double variance);
+/// How the extra states wander (FilterState::extra): the map-matching bias a Gauss-Markov process in
+/// distance (it fades to 1/e over bias_length of travel towards a stationary `bias_variance` per axis);
+/// the odometry's scale error a random walk in distance and its gyro's bias one in time.
+struct ExtraNoise {
+  double bias_length = 10.0;    ///< m
+  double bias_variance = 0.0;   ///< m^2
+  double scale_walk = 0.0;      ///< 1/sqrt(m): the scale error's variance grows by scale_walk^2 per metre
+  double gyro_bias_walk = 0.0;  ///< rad/s/sqrt(s)
+};
+
+/// The extra states over one step of dt at speed vx: the bias fades by phi = exp(-|vx| dt / length)
+/// and its covariance goes to phi^2 P + (1 - phi^2) variance I, which stays at `variance` once there;
+/// the odometry's errors are held, their variances grown by their walks; the six states' covariance
+/// with them is carried by A and phi.
+void propagateExtra(ExtraStates& extra, const Matrix6d& A, double vx, double dt, const ExtraNoise& noise);
 
 }  // namespace coloc::fusion

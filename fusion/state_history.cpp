@@ -52,9 +52,8 @@ void StateHistory::predictInto(const FilterState& from, Slot& into, bool first_t
     prior.x = into.predicted_from_linearization + into.jacobian * delta;
     prior.P = propagateCovariance(into.jacobian, from.P, Q_);
   }
-  prior.bias = from.bias;
-  if (prior.bias.modelled)
-    propagateBias(prior.bias, options_.relinearize || first_time ? A_used : into.jacobian, from.x[kVx], dt_, options_.bias_length, bias_variance_);
+  prior.extra = from.extra;
+  if (prior.extra.any()) propagateExtra(prior.extra, options_.relinearize || first_time ? A_used : into.jacobian, from.x[kVx], dt_, options_.extra);
   prior.aux = from.aux;
   predictAux(prior, options_.aux_proc_dev, dt_);
 }

@@ -26,7 +26,9 @@ struct HistoryOptions {
   ProcessNoise noise;
   std::array<double, 3> aux_proc_dev{5.0, 0.1, 0.1};  ///< z, roll, pitch random walks
   bool relinearize = true;
-  double bias_length = 10.0;            ///< m; the map-matching bias's fade (where the state models it)
+  /// How the extra states wander (where the state models them); its bias_variance is the place's,
+  /// set by setBiasVariance.
+  ExtraNoise extra;
 };
 
 class StateHistory {
@@ -60,8 +62,8 @@ class StateHistory {
 
   /// The map-matching bias's stationary variance from now on (the place's); the steps of the history
   /// filtered again after a late measurement take it too, a second at most of travel.
-  void setBiasVariance(double variance) { bias_variance_ = variance; }
-  double biasVariance() const { return bias_variance_; }
+  void setBiasVariance(double variance) { options_.extra.bias_variance = variance; }
+  double biasVariance() const { return options_.extra.bias_variance; }
 
  private:
   struct Slot {
@@ -87,7 +89,6 @@ class StateHistory {
   int count_ = 0;
   Stamp latest_stamp_ = 0;
   int dirty_ = -1;  ///< oldest slot (ticks back) whose posterior is stale; -1 = none
-  double bias_variance_ = 0.0;
 };
 
 }  // namespace coloc::fusion

@@ -527,12 +527,16 @@ struct Pipeline::Impl {
     // the vehicle, and its own slow errors (a gyro's bias, a wheel's scale) would pass for NDT's: the
     // bias is then held to nothing (it fades over its length) and the pose floored at its place's whole
     // error, as without the bias (site C's NDT alone, in coverage: 2.7 cm with the bias loose, 1.4 cm).
+    // Where the filter models those slow errors as states (fusion.odometry_scale_sd,
+    // odometry_yaw_rate_bias_sd), the odometry is what the filter says it is, and the bias is loose
+    // everywhere.
     const double place = ndt_quality.varianceAt(pose.pose.position.head<2>());
     double floor = place;
     const std::optional<fusion::Estimate> now = localizer.estimate();
     if (config.fusion.map_match_bias_sd > 0.0) {
       const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
-      const bool told_apart = last_anchor && pose.stamp - *last_anchor <= fromSeconds(hold);
+      const bool odometry_modelled = config.fusion.odometry_scale_sd > 0.0 || config.fusion.odometry_yaw_rate_bias_sd > 0.0;
+      const bool told_apart = odometry_modelled || (last_anchor && pose.stamp - *last_anchor <= fromSeconds(hold));
       double spread = 0.0;
       if (told_apart) {
         spread = config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
@@ -875,6 +879,17 @@ PipelineReport Pipeline::report() const {
   r.yaw_rate_bias_time = impl_->yaw_rate_bias.comparedTime();
   r.mount_yaw = impl_->mount_yaw.yaw();
   r.mount_yaw_distance = impl_->mount_yaw.comparedDistance();
+  if (impl_->config.fusion.odometry_scale_sd > 0.0 || impl_->config.fusion.odometry_yaw_rate_bias_sd > 0.0) {
+    std::lock_guard<std::mutex> lock(impl_->estimate_mutex);
+    if (impl_->latest) {
+      const fusion::Estimate& e = *impl_->latest;
+      r.filter_odometry_modelled = true;
+      r.filter_odometry_scale_error = e.odometry_scale_error;
+      r.filter_odometry_scale_sd = std::sqrt(std::max(e.odometry_error_covariance(0, 0), 0.0));
+      r.filter_yaw_rate_bias = e.odometry_yaw_rate_bias;
+      r.filter_yaw_rate_bias_sd = std::sqrt(std::max(e.odometry_error_covariance(1, 1), 0.0));
+    }
+  }
   return r;
 }
 

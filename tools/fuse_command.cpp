@@ -98,6 +98,9 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
     std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
     std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);
+    if (const pipeline::PipelineReport& p = r.pipeline_report; p.filter_odometry_modelled)
+      std::printf("  the filter's odometry states: speed reading high by %+.4f (sd %.4f), gyro bias %+.5f rad/s (sd %.5f)\n", p.filter_odometry_scale_error,
+                  p.filter_odometry_scale_sd, p.filter_yaw_rate_bias, p.filter_yaw_rate_bias_sd);
   } else if (map_given) {
     std::printf("\n  the map was not used: no topic of the log is a scan (PointCloud2) for NDT to match\n");
   }

@@ -381,6 +381,15 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
     if (key.first != pipeline::kNdtSource) continue;
     EXPECT_LT(covariance.trace(), 0.1) << "the fit's own covariance, as before";
   }
+  // With the odometry's slow errors modelled as well, nothing is left that held the bias: it is loose
+  // everywhere, the poses floored at the map's noise (0 here), and the report gives the states.
+  const ReplayResult loose =
+      replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "poor.yaml") + "\nfusion:\n  map_match_bias_sd: 0.1\n  odometry_scale_sd: 0.02\n");
+  EXPECT_EQ(loose.pipeline_report.ndt_quality_raised, 0u);
+  EXPECT_TRUE(loose.pipeline_report.filter_odometry_modelled);
+  EXPECT_FALSE(held.pipeline_report.filter_odometry_modelled);
+  EXPECT_NE(loose.summaryJson("scans").find("\"filter_odometry_states\""), std::string::npos);
+  EXPECT_EQ(held.summaryJson("scans").find("\"filter_odometry_states\""), std::string::npos);
   // The same poses where the map's only cell lies elsewhere and its default is nothing: as NDT gave them.
   std::ofstream(dir / "elsewhere.yaml") << pipeline::NdtQualityMap::fromErrors({samples.begin() + 5, samples.end()}, 10.0, 5, 0.0).toYaml();
   EXPECT_EQ(replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "elsewhere.yaml") + "\n").pipeline_report.ndt_quality_raised, 0u);

@@ -112,6 +112,20 @@ struct EkfConfig {
   // tell the bias apart and NDT's poses then correct by their noise alone.
   double map_match_bias_sd = 0.0;       ///< m; 0 = not modelled
   double map_match_bias_length = 10.0;  ///< m
+
+  // The odometry's slow errors as states (coloc's; off by default). A wheel's radius off by 1 % and a
+  // gyro's bias of a few mrad/s are not white noise: a filter that takes the odometry at its white
+  // noise alone follows them between poses, and one that takes it at Autoware's 0.2 m/s and 0.1 rad/s
+  // hides them but then weighs every pose against a prediction far looser than it is. On: two more
+  // states, the share by which the twist's speed reads high (it measures (1 + scale) vx) and the
+  // gyro's bias (it measures wz + bias), learned from the poses; each starts at zero with the sd
+  // given and wanders by its walk. The pipeline's own learners (pipeline.speed_scale_estimation,
+  // yaw_rate_bias_estimation) correct the twists before the filter; with these states on they are
+  // best off, or the states see only what those leave.
+  double odometry_scale_sd = 0.0;            ///< initial sd of the speed scale's error; 0 = not modelled
+  double odometry_scale_walk = 0.0;          ///< 1/sqrt(m); its variance grows by walk^2 per metre
+  double odometry_yaw_rate_bias_sd = 0.0;    ///< rad/s; initial sd of the gyro's bias
+  double odometry_yaw_rate_bias_walk = 0.0;  ///< rad/s/sqrt(s); its variance grows by walk^2 per second
 };
 
 }  // namespace coloc::fusion

@@ -37,6 +37,12 @@ struct Estimate {
   /// minus the position, map frame, and its covariance.
   Eigen::Vector2d map_match_bias = Eigen::Vector2d::Zero();
   Eigen::Matrix2d map_match_bias_covariance = Eigen::Matrix2d::Zero();
+  /// The odometry's slow errors as the filter learned them (EkfConfig::odometry_scale_sd; zero where
+  /// not modelled): the share by which its speed reads high, its gyro's bias (rad/s), and their
+  /// covariance.
+  double odometry_scale_error = 0.0;
+  double odometry_yaw_rate_bias = 0.0;
+  Eigen::Matrix2d odometry_error_covariance = Eigen::Matrix2d::Zero();
   /// Whether to believe it (see integrity.hpp); degraded or lost, pose_covariance includes the
   /// disagreement that made it so (state_covariance is the filter's own).
   LocalizationState localization = LocalizationState::kInitialising;

@@ -78,6 +78,12 @@ struct PipelineReport {
   double yaw_rate_bias_time = 0.0;           ///< s compared so far
   double mount_yaw = 0.0;                    ///< rad, NDT's heading minus the direction of travel (0 until known)
   double mount_yaw_distance = 0.0;           ///< m compared so far
+  /// The filter's own estimate of the odometry's slow errors at its latest tick (fusion.odometry_scale_sd,
+  /// odometry_yaw_rate_bias_sd; false and zero where not modelled): the share by which its speed reads
+  /// high and its gyro's bias (rad/s), each with its sd.
+  bool filter_odometry_modelled = false;
+  double filter_odometry_scale_error = 0.0, filter_odometry_scale_sd = 0.0;
+  double filter_yaw_rate_bias = 0.0, filter_yaw_rate_bias_sd = 0.0;
   /// NDT poses whose travel over pipeline.travel_check_window disagreed with the odometry's beyond the
   /// tolerance (their covariance widened by the excess), and the largest excess, m.
   std::uint64_t ndt_travel_disagreements = 0;
