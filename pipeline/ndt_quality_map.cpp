@@ -55,7 +55,8 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
   map.gross_left_out_ = static_cast<std::size_t>(std::count(gross.begin(), gross.end(), true));
   std::map<std::pair<long long, long long>, std::pair<double, std::size_t>> sums;
   double change = 0.0, all = 0.0;  // all: the drive's own sum, for the default
-  std::size_t changes = 0, poses = 0;
+  std::size_t changes = 0, poses = 0, turned = 0;
+  Eigen::Vector2d change_along_across = Eigen::Vector2d::Zero();
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const NdtQualitySample& s = samples[i];
     if (gross[i]) continue;
@@ -65,15 +66,31 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
     all += 0.5 * s.error.squaredNorm(), ++poses;
     // Two independent draws of the noise differ by twice its variance, per axis; x and y pooled.
     if (i > 0 && !gross[i - 1] && (s.position - samples[i - 1].position).norm() < cell) {
-      change += 0.25 * (s.error - samples[i - 1].error).squaredNorm();
+      const Eigen::Vector2d d = s.error - samples[i - 1].error;
+      change += 0.25 * d.squaredNorm();
       ++changes;
+      if (std::isfinite(s.heading)) {
+        const double c = std::cos(s.heading), sn = std::sin(s.heading);
+        const Eigen::Vector2d body(c * d.x() + sn * d.y(), -sn * d.x() + c * d.y());
+        change_along_across += 0.5 * body.cwiseProduct(body);
+        ++turned;
+      }
     }
   }
   if (changes > 0) map.noise_variance_ = std::min(change / static_cast<double>(changes), kMaxVariance);
+  if (turned > 0) map.noise_along_across_ = (change_along_across / static_cast<double>(turned)).cwiseMin(kMaxVariance);
   map.default_variance_ = default_variance ? *default_variance : poses ? std::min(all / static_cast<double>(poses), kMaxVariance) : 0.0;
   for (const auto& [index, sum] : sums)
     if (sum.second >= std::max<std::size_t>(min_samples, 1)) map.cells_[index] = {sum.first / static_cast<double>(sum.second), sum.second};
   return map;
+}
+
+std::optional<Eigen::Matrix2d> NdtQualityMap::noiseAt(double heading) const {
+  if (!noise_along_across_ || !std::isfinite(heading)) return std::nullopt;
+  const double c = std::cos(heading), s = std::sin(heading);
+  Eigen::Matrix2d turn;
+  turn << c, -s, s, c;  // the vehicle's axes in the map
+  return turn * noise_along_across_->asDiagonal() * turn.transpose();
 }
 
 double NdtQualityMap::varianceAt(const Eigen::Vector2d& xy) const {
@@ -90,6 +107,9 @@ std::string NdtQualityMap::toYaml() const {
       << "cell: " << cell_ << "  # m; cell [i, j] spans x in [i, i + 1) * cell, y in [j, j + 1) * cell\n"
       << "default_variance: " << default_variance_ << "  # m^2, where no cell is listed\n"
       << "noise_variance: " << noise_variance_ << "  # m^2 per axis: NDT's scan-to-scan noise (half the mean square change between consecutive poses)\n";
+  if (noise_along_across_)
+    out << "noise_along: " << noise_along_across_->x() << "  # m^2: the same along the vehicle\n"
+        << "noise_across: " << noise_along_across_->y() << "  # m^2: and across it\n";
   if (gross_left_out_ > 0)
     out << "# " << gross_left_out_ << " pose(s) left out as gross errors (over " << kGrossError << "x their cell's median error): the travel check's to catch, not the place's\n";
   out
@@ -103,11 +123,17 @@ NdtQualityMap NdtQualityMap::parse(const std::string& text, const std::string& s
   const YamlReader r(source);
   const YAML::Node root = r.parse(text);
   if (!root.IsMap()) r.fail(root, "(top level)", "expected a mapping with cell, default_variance and cells");
-  r.allowKeys(root, "(top level)", {"cell", "default_variance", "noise_variance", "cells"});
+  r.allowKeys(root, "(top level)", {"cell", "default_variance", "noise_variance", "noise_along", "noise_across", "cells"});
   NdtQualityMap map;
   map.cell_ = r.inRange(r.require(root, "cell", "(top level)"), "cell", kMinCell, kMaxCell);
   map.default_variance_ = r.inRange(r.require(root, "default_variance", "(top level)"), "default_variance", 0.0, kMaxVariance);
   if (const YAML::Node noise = root["noise_variance"]) map.noise_variance_ = r.inRange(noise, "noise_variance", 0.0, kMaxVariance);
+  const YAML::Node along = root["noise_along"], across = root["noise_across"];
+  if (along || across) {
+    if (!along) r.fail(across, "noise_across", "given without noise_along");
+    if (!across) r.fail(along, "noise_along", "given without noise_across");
+    map.noise_along_across_ = Eigen::Vector2d(r.inRange(along, "noise_along", 0.0, kMaxVariance), r.inRange(across, "noise_across", 0.0, kMaxVariance));
+  }
   const YAML::Node cells = r.require(root, "cells", "(top level)");
   if (!cells.IsSequence()) r.fail(cells, "cells", "expected a list of [i, j, poses, variance]");
   const long long reach = static_cast<long long>(kMaxCoordinate / map.cell_) + 1;

@@ -541,6 +541,15 @@ struct Pipeline::Impl {
       if (told_apart) {
         spread = config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
         if (place > 0.0) floor = ndt_quality.noiseVariance(), spread = std::max(place - floor, 0.0);
+        // The noise along the vehicle and across it, turned to the map by NDT's own heading.
+        const std::optional<Eigen::Matrix2d> noise = ndt_quality.noiseAt(rollPitchYaw(pose.pose.orientation)[2]);
+        if (place > 0.0 && config.ndt.quality_noise_by_direction && noise) {
+          const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
+          pose.covariance.topLeftCorner<2, 2>() = coveringAtLeast(xy, *noise);
+          if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_raised;
+          spread = std::max(place - 0.5 * noise->trace(), 0.0);
+          floor = 0.0;
+        }
       }
       localizer.setMapMatchBiasVariance(spread);
     }

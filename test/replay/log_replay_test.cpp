@@ -390,6 +390,20 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
   EXPECT_FALSE(held.pipeline_report.filter_odometry_modelled);
   EXPECT_NE(loose.summaryJson("scans").find("\"filter_odometry_states\""), std::string::npos);
   EXPECT_EQ(held.summaryJson("scans").find("\"filter_odometry_states\""), std::string::npos);
+  // NDT's noise measured along the vehicle and across it (ndt.quality_noise_by_direction): where the
+  // bias is loose, each pose floored at each in its own direction (NdtQualityMap::noiseAt,
+  // coveringAtLeast); the poses the filter takes are not reported on their own, which stay at their
+  // place's whole error.
+  std::vector<pipeline::NdtQualitySample> shaking;
+  for (int i = 0; i < 6; ++i) shaking.push_back({here, Eigen::Vector2d(i % 2 ? 0.2 : -0.2, 0.0), 0.0});
+  const pipeline::NdtQualityMap along = pipeline::NdtQualityMap::fromErrors(shaking, 10.0, 5, 0.0);
+  ASSERT_TRUE(along.noiseAlongAcross());
+  std::ofstream(dir / "along.yaml") << along.toYaml();
+  const ReplayResult by_direction = replayAgainstThePairsMap(
+      dir / "scans", "  quality_map: " + (dir / "along.yaml") + "\n  quality_noise_by_direction: true\nfusion:\n  map_match_bias_sd: 0.1\n  odometry_scale_sd: 0.02\n");
+  EXPECT_EQ(by_direction.pipeline_report.ndt_quality_raised, 3u) << "the fit's 1 cm along raised to the noise's 28 cm";
+  for (const auto& [key, covariance] : by_direction.claimedCovariances())
+    if (key.first == pipeline::kNdtSource) EXPECT_GE(std::min(covariance(0, 0), covariance(1, 1)), along.varianceAt(here) * (1.0 - 1e-9));
   // The same poses where the map's only cell lies elsewhere and its default is nothing: as NDT gave them.
   std::ofstream(dir / "elsewhere.yaml") << pipeline::NdtQualityMap::fromErrors({samples.begin() + 5, samples.end()}, 10.0, 5, 0.0).toYaml();
   EXPECT_EQ(replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "elsewhere.yaml") + "\n").pipeline_report.ndt_quality_raised, 0u);

@@ -27,6 +27,14 @@ inline Eigen::Matrix2d principalVariancesAtLeast(const Eigen::Matrix2d& covarian
   return mapPrincipalVariances(covariance, [variance](double v) { return v < variance ? variance : v; });
 }
 
+/// At least `covariance` and at least `floor` in every direction: covariance + (floor - covariance)+,
+/// the positive part of the difference (a floor that is not round, NDT's noise along a vehicle and
+/// across it). With floor = v I it is principalVariancesAtLeast(covariance, v).
+inline Eigen::Matrix2d coveringAtLeast(const Eigen::Matrix2d& covariance, const Eigen::Matrix2d& floor) {
+  const Eigen::Matrix2d symmetric = 0.5 * (covariance + covariance.transpose());
+  return symmetric + mapPrincipalVariances(floor - symmetric, [](double v) { return v > 0.0 ? v : 0.0; });
+}
+
 /// The largest variance in any direction (the larger eigenvalue of the symmetric part), at least 0;
 /// NaN if the covariance has no real eigen-decomposition.
 inline double largestPrincipalVariance(const Eigen::Matrix2d& covariance) {

@@ -74,6 +74,12 @@ struct NdtSection {
   /// NDT's mean square error by place (NdtQualityMap's file, relative to the config file); each NDT
   /// pose's x/y variance at least its cell's. Empty: none.
   std::string quality_map;
+  /// Where the filter's map-matching bias is loose (fusion.map_match_bias_sd), each NDT pose is floored
+  /// at the map's scan-to-scan noise along the vehicle and across it (the file's noise_along and
+  /// noise_across, where it has them) instead of at its one figure per axis. Off by default: measured
+  /// on the twin it makes NDT's innovations across the road honest but not yet along it
+  /// (docs/filter.md, *The odometry's slow errors*).
+  bool quality_noise_by_direction = false;
 };
 
 /// Roadside fixes: which RSUs are trusted and how fresh a fix must be.

@@ -8,6 +8,7 @@
 // drive left too few poses). Nothing here knows NDT or the filter.
 #include <Eigen/Core>
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -21,6 +22,9 @@ namespace coloc::pipeline {
 struct NdtQualitySample {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   Eigen::Vector2d error = Eigen::Vector2d::Zero();
+  /// rad, the vehicle's heading there (the reference's), for NDT's noise along and across it; NaN:
+  /// not known, and the pose counts in the noise per axis only.
+  double heading = std::numeric_limits<double>::quiet_NaN();
 };
 
 class NdtQualityMap {
@@ -33,7 +37,7 @@ class NdtQualityMap {
   /// `default_variance` answers elsewhere; not given, the drive's own mean square over all its poses.
   /// The samples in drive order also give NDT's scan-to-scan noise: half the mean square change of the
   /// error between consecutive poses less than a cell apart (what a bias alike from one scan to the
-  /// next leaves). Gross errors (grossErrors) count in none of these. Throws coloc::Error for a cell or
+  /// next leaves), per axis and, where the samples give the heading, along and across the vehicle. Gross errors (grossErrors) count in none of these. Throws coloc::Error for a cell or
   /// default out of range or a non-finite sample.
   static NdtQualityMap fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples,
                                   std::optional<double> default_variance = std::nullopt);
@@ -59,6 +63,14 @@ class NdtQualityMap {
   /// NDT's scan-to-scan noise variance per axis (0: not measured, as in files written before it was).
   /// What an NDT pose is worth where the filter models the bias its poses share.
   double noiseVariance() const { return noise_variance_; }
+  /// The same noise along the vehicle and across it (m^2; nullopt where not measured: samples without
+  /// a heading, files written before it was). NDT's scan-to-scan noise is far from round: on the twin's
+  /// sites A-C 0.7-1.3 cm along the vehicle and 0.1-0.7 cm across it, where the figure per axis is
+  /// 0.6-1.0 cm (docs/filter.md, *The odometry's slow errors*).
+  std::optional<Eigen::Vector2d> noiseAlongAcross() const { return noise_along_across_; }
+  /// That noise as an x/y covariance for a vehicle heading `heading` (rad, map frame); nullopt where
+  /// not measured.
+  std::optional<Eigen::Matrix2d> noiseAt(double heading) const;
 
   double cellSize() const { return cell_; }
   double defaultVariance() const { return default_variance_; }
@@ -73,6 +85,7 @@ class NdtQualityMap {
   double cell_ = 10.0;
   double default_variance_ = 0.0;
   double noise_variance_ = 0.0;
+  std::optional<Eigen::Vector2d> noise_along_across_;
   std::size_t gross_left_out_ = 0;
   std::map<std::pair<long long, long long>, Cell> cells_;  ///< by (floor(x / cell), floor(y / cell))
   std::pair<long long, long long> indexOf(const Eigen::Vector2d& xy) const;
