@@ -323,7 +323,7 @@ struct Localizer::Impl {
         s.extra.cross(si, bi) = -variance;
       }
     }
-    if (config.odometry_scale_sd > 0.0 || config.odometry_yaw_rate_bias_sd > 0.0) {
+    if (config.modelsOdometryErrors()) {
       // The odometry's errors start unknown but for their spread: what a start learned is not kept
       // (a recovery starts afresh, as the pipeline's own learners do).
       s.extra.odometry_modelled = true;

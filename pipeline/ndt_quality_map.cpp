@@ -1,5 +1,7 @@
 #include "coloc/pipeline/ndt_quality_map.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -70,8 +72,7 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
       change += 0.25 * d.squaredNorm();
       ++changes;
       if (std::isfinite(s.heading)) {
-        const double c = std::cos(s.heading), sn = std::sin(s.heading);
-        const Eigen::Vector2d body(c * d.x() + sn * d.y(), -sn * d.x() + c * d.y());
+        const Eigen::Vector2d body = Eigen::Rotation2Dd(-s.heading) * d;  // along, across
         change_along_across += 0.5 * body.cwiseProduct(body);
         ++turned;
       }
@@ -87,9 +88,7 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
 
 std::optional<Eigen::Matrix2d> NdtQualityMap::noiseAt(double heading) const {
   if (!noise_along_across_ || !std::isfinite(heading)) return std::nullopt;
-  const double c = std::cos(heading), s = std::sin(heading);
-  Eigen::Matrix2d turn;
-  turn << c, -s, s, c;  // the vehicle's axes in the map
+  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(heading).toRotationMatrix();  // the vehicle's axes in the map
   return turn * noise_along_across_->asDiagonal() * turn.transpose();
 }
 

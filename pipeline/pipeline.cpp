@@ -535,15 +535,16 @@ struct Pipeline::Impl {
     const std::optional<fusion::Estimate> now = localizer.estimate();
     if (config.fusion.map_match_bias_sd > 0.0) {
       const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
-      const bool odometry_modelled = config.fusion.odometry_scale_sd > 0.0 || config.fusion.odometry_yaw_rate_bias_sd > 0.0;
-      const bool told_apart = odometry_modelled || (last_anchor && pose.stamp - *last_anchor <= fromSeconds(hold));
+      const bool told_apart = config.fusion.modelsOdometryErrors() || (last_anchor && pose.stamp - *last_anchor <= fromSeconds(hold));
       double spread = 0.0;
       if (told_apart) {
         spread = config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
         if (place > 0.0) floor = ndt_quality.noiseVariance(), spread = std::max(place - floor, 0.0);
         // The noise along the vehicle and across it, turned to the map by NDT's own heading.
-        const std::optional<Eigen::Matrix2d> noise = ndt_quality.noiseAt(rollPitchYaw(pose.pose.orientation)[2]);
-        if (place > 0.0 && config.ndt.quality_noise_by_direction && noise) {
+        const std::optional<Eigen::Matrix2d> noise = place > 0.0 && config.ndt.quality_noise_by_direction
+                                                         ? ndt_quality.noiseAt(rollPitchYaw(pose.pose.orientation)[2])
+                                                         : std::nullopt;
+        if (noise) {
           const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
           pose.covariance.topLeftCorner<2, 2>() = coveringAtLeast(xy, *noise);
           if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_raised;
@@ -888,7 +889,7 @@ PipelineReport Pipeline::report() const {
   r.yaw_rate_bias_time = impl_->yaw_rate_bias.comparedTime();
   r.mount_yaw = impl_->mount_yaw.yaw();
   r.mount_yaw_distance = impl_->mount_yaw.comparedDistance();
-  if (impl_->config.fusion.odometry_scale_sd > 0.0 || impl_->config.fusion.odometry_yaw_rate_bias_sd > 0.0) {
+  if (impl_->config.fusion.modelsOdometryErrors()) {
     std::lock_guard<std::mutex> lock(impl_->estimate_mutex);
     if (impl_->latest) {
       const fusion::Estimate& e = *impl_->latest;

@@ -126,6 +126,9 @@ struct EkfConfig {
   double odometry_scale_walk = 0.0;          ///< 1/sqrt(m); its variance grows by walk^2 per metre
   double odometry_yaw_rate_bias_sd = 0.0;    ///< rad/s; initial sd of the gyro's bias
   double odometry_yaw_rate_bias_walk = 0.0;  ///< rad/s/sqrt(s); its variance grows by walk^2 per second
+
+  /// Whether the odometry's slow errors are states (either sd given).
+  bool modelsOdometryErrors() const { return odometry_scale_sd > 0.0 || odometry_yaw_rate_bias_sd > 0.0; }
 };
 
 }  // namespace coloc::fusion

@@ -37,8 +37,9 @@ class NdtQualityMap {
   /// `default_variance` answers elsewhere; not given, the drive's own mean square over all its poses.
   /// The samples in drive order also give NDT's scan-to-scan noise: half the mean square change of the
   /// error between consecutive poses less than a cell apart (what a bias alike from one scan to the
-  /// next leaves), per axis and, where the samples give the heading, along and across the vehicle. Gross errors (grossErrors) count in none of these. Throws coloc::Error for a cell or
-  /// default out of range or a non-finite sample.
+  /// next leaves), per axis and, where the samples give the heading, along and across the vehicle.
+  /// Gross errors (grossErrors) count in none of these. Throws coloc::Error for a cell or default out
+  /// of range or a non-finite sample.
   static NdtQualityMap fromErrors(const std::vector<NdtQualitySample>& samples, double cell, std::size_t min_samples,
                                   std::optional<double> default_variance = std::nullopt);
 
