@@ -582,6 +582,7 @@ std::string LiveLocalizer::summaryJson() const {
   if (s.report.ndt_used) {
     j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(s.report.ndt, s.report.map, s.report.scans_without_guess));
     j["ndt"]["scans_superseded"] = s.report.scans_superseded;
+    j.update(nlohmann::ordered_json::parse(pipeline::learnedJson(s.report)));
   }
   if (!s.report.fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(s.report.fixes, s.report.filter_of_fixes));
   j["localization"] = nlohmann::ordered_json::parse(pipeline::localizationJson(s.report));

@@ -86,4 +86,21 @@ std::string localizationJson(const PipelineReport& r) {
   return j.dump();
 }
 
+std::string learnedJson(const PipelineReport& r) {
+  nlohmann::ordered_json j;
+  j["ndt_travel_check"] = {{"disagreements", r.ndt_travel_disagreements}, {"max_excess_m", r.ndt_travel_max_excess},
+                           {"unverified", r.ndt_travel_unverified}};
+  j["ndt_fix_agreement"] = {{"disagreements", r.ndt_fix_disagreements}, {"max_excess_m", r.ndt_fix_max_excess}};
+  j["ndt_quality_map"] = {{"raised", r.ndt_quality_raised}};
+  j["odometry_speed_scale"] = {{"scale", r.speed_scale}, {"compared_m", r.speed_scale_distance}};
+  j["odometry_yaw_rate_bias"] = {{"bias_rad_s", r.yaw_rate_bias}, {"compared_s", r.yaw_rate_bias_time}};
+  j["lidar_mount_yaw"] = {{"yaw_rad", r.mount_yaw}, {"compared_m", r.mount_yaw_distance}};
+  if (r.filter_odometry_modelled)
+    j["filter_odometry_states"] = {{"speed_scale_error", r.filter_odometry_scale_error},
+                                   {"speed_scale_error_sd", r.filter_odometry_scale_sd},
+                                   {"yaw_rate_bias_rad_s", r.filter_yaw_rate_bias},
+                                   {"yaw_rate_bias_sd_rad_s", r.filter_yaw_rate_bias_sd}};
+  return j.dump();
+}
+
 }  // namespace coloc::pipeline

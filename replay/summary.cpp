@@ -72,18 +72,7 @@ std::string ReplayResult::summaryJson(const std::string& log) const {
   }
   if (ndt_used) {
     j["ndt"] = nlohmann::ordered_json::parse(pipeline::ndtJson(ndt, map, scans_without_guess));
-    j["ndt_travel_check"] = {{"disagreements", pipeline_report.ndt_travel_disagreements}, {"max_excess_m", pipeline_report.ndt_travel_max_excess},
-                             {"unverified", pipeline_report.ndt_travel_unverified}};
-    j["ndt_fix_agreement"] = {{"disagreements", pipeline_report.ndt_fix_disagreements}, {"max_excess_m", pipeline_report.ndt_fix_max_excess}};
-    j["ndt_quality_map"] = {{"raised", pipeline_report.ndt_quality_raised}};
-    j["odometry_speed_scale"] = {{"scale", speed_scale}, {"compared_m", speed_scale_distance}};
-    j["odometry_yaw_rate_bias"] = {{"bias_rad_s", yaw_rate_bias}, {"compared_s", yaw_rate_bias_time}};
-    j["lidar_mount_yaw"] = {{"yaw_rad", mount_yaw}, {"compared_m", mount_yaw_distance}};
-    if (pipeline_report.filter_odometry_modelled)
-      j["filter_odometry_states"] = {{"speed_scale_error", pipeline_report.filter_odometry_scale_error},
-                                     {"speed_scale_error_sd", pipeline_report.filter_odometry_scale_sd},
-                                     {"yaw_rate_bias_rad_s", pipeline_report.filter_yaw_rate_bias},
-                                     {"yaw_rate_bias_sd_rad_s", pipeline_report.filter_yaw_rate_bias_sd}};
+    j.update(nlohmann::ordered_json::parse(pipeline::learnedJson(pipeline_report)));
     j["lidar_pose"] = {{"xyz_rpy", std::vector<double>(lidar_pose.data(), lidar_pose.data() + 6)}, {"from", lidar_pose_from}};
   }
   if (!fixes.empty()) j["rsu_fixes"] = nlohmann::ordered_json::parse(pipeline::fixesJson(fixes, pipeline_report.filter_of_fixes));

@@ -85,22 +85,7 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     const Vector6d& l = r.lidar_pose;
     std::printf("  LiDAR on the vehicle: [%.3f, %.3f, %.3f] m, roll %.2f, pitch %.2f, yaw %.2f deg, from %s\n", l[0], l[1], l[2], l[3] * 180.0 / M_PI,
                 l[4] * 180.0 / M_PI, l[5] * 180.0 / M_PI, r.lidar_pose_from.c_str());
-    std::printf("  NDT's travel against the odometry's: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m), "
-                "%llu had none to compare yet\n",
-                (unsigned long long)r.pipeline_report.ndt_travel_disagreements,
-                r.pipeline_report.ndt_travel_max_excess, (unsigned long long)r.pipeline_report.ndt_travel_unverified);
-    if (r.pipeline_report.ndt_fix_disagreements > 0)
-      std::printf("  NDT's position against the roadside's fixes: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m)\n",
-                  (unsigned long long)r.pipeline_report.ndt_fix_disagreements, r.pipeline_report.ndt_fix_max_excess);
-    if (r.pipeline_report.ndt_quality_raised > 0)
-      std::printf("  NDT's error by place (ndt.quality_map): %llu poses' covariance raised to their place's figure\n",
-                  (unsigned long long)r.pipeline_report.ndt_quality_raised);
-    std::printf("  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
-    std::printf("  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
-    std::printf("  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);
-    if (const pipeline::PipelineReport& p = r.pipeline_report; p.filter_odometry_modelled)
-      std::printf("  the filter's odometry states: speed reading high by %+.4f (sd %.4f), gyro bias %+.5f rad/s (sd %.5f)\n", p.filter_odometry_scale_error,
-                  p.filter_odometry_scale_sd, p.filter_yaw_rate_bias, p.filter_yaw_rate_bias_sd);
+    std::printf("%s", learnedLines(r.pipeline_report).c_str());
   } else if (map_given) {
     std::printf("\n  the map was not used: no topic of the log is a scan (PointCloud2) for NDT to match\n");
   }

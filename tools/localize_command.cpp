@@ -164,6 +164,7 @@ void addLocalizeCommand(CLI::App& app) {
     for (const auto& t : s.topics)
       if (t.from_before_clock_jump)
         std::printf("  %s: %llu sent before /clock went back and arriving after, dropped\n", t.topic.c_str(), (unsigned long long)t.from_before_clock_jump);
+    if (s.report.ndt_used) std::printf("%s", learnedLines(s.report).c_str());
     for (const auto& [id, c] : s.report.fixes) std::printf("  %s\n", fixLine(id, s.report).c_str());
     std::printf("  localization: %s\n", localizationLine(s.report).c_str());
     for (const auto& line : s.report.first_rejections) std::printf("  rejected: %s\n", line.c_str());

@@ -1,5 +1,7 @@
 #include "report_lines.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace coloc::tools {
@@ -33,6 +35,36 @@ std::string localizationLine(const pipeline::PipelineReport& r) {
   out << "; " << r.recoveries << (r.recoveries == 1 ? " recovery" : " recoveries") << ", " << r.losses << " times lost, " << r.degradations
       << " degraded; " << r.clock_resets << " clock resets";
   return out.str();
+}
+
+namespace {
+
+template <typename... Args>
+void line(std::string& out, const char* format, Args... args) {
+  char buffer[512];
+  std::snprintf(buffer, sizeof buffer, format, args...);
+  out += buffer;
+}
+
+}  // namespace
+
+std::string learnedLines(const pipeline::PipelineReport& r) {
+  std::string out;
+  line(out, "  NDT's travel against the odometry's: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m), "
+            "%llu had none to compare yet\n",
+       (unsigned long long)r.ndt_travel_disagreements, r.ndt_travel_max_excess, (unsigned long long)r.ndt_travel_unverified);
+  if (r.ndt_fix_disagreements > 0)
+    line(out, "  NDT's position against the roadside's fixes: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m)\n",
+         (unsigned long long)r.ndt_fix_disagreements, r.ndt_fix_max_excess);
+  if (r.ndt_quality_raised > 0)
+    line(out, "  NDT's error by place (ndt.quality_map): %llu poses' covariance raised to their place's figure\n", (unsigned long long)r.ndt_quality_raised);
+  line(out, "  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
+  line(out, "  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
+  line(out, "  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);
+  if (r.filter_odometry_modelled)
+    line(out, "  the filter's odometry states: speed reading high by %+.4f (sd %.4f), gyro bias %+.5f rad/s (sd %.5f)\n", r.filter_odometry_scale_error,
+         r.filter_odometry_scale_sd, r.filter_yaw_rate_bias, r.filter_yaw_rate_bias_sd);
+  return out;
 }
 
 }  // namespace coloc::tools

@@ -11,5 +11,9 @@ namespace coloc::tools {
 std::string fixLine(const std::string& rsu_id, const pipeline::PipelineReport& report);
 /// "localized since 12.3 s; started: position from ..., heading ...; 1 recovery; 0 clock resets"
 std::string localizationLine(const pipeline::PipelineReport& report);
+/// What the pipeline learned and corrected where NDT ran: its travel and fix checks, its quality map,
+/// the odometry's scale and gyro bias, the LiDAR's mounting yaw, the filter's odometry states; one
+/// line each, indented.
+std::string learnedLines(const pipeline::PipelineReport& report);
 
 }  // namespace coloc::tools

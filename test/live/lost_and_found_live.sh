@@ -72,6 +72,14 @@ grep -q '"started_how": "position from /rsu/rsu_a/fix' "$summary" || { echo "FAI
 [ "$(json "$summary" addressed_to_another)" -gt 0 ] || { echo "FAIL: no fix of the other vehicle was heard and refused"; exit 1; }
 awk -v w="$worst" -v m="$mean" -v r="$reference" 'BEGIN { exit !(w < 0.3 && m <= 1.2 * r) }' ||
   { echo "FAIL: live error ${mean} m (worst ${worst} m) against offline ${reference} m"; exit 1; }
+# What NDT taught the pipeline is reported live as offline: the odometry's speed scale (the twin's
+# reads 1 % high), in summary.json and in the lines said at the stop.
+learned() { sed -n '/"odometry_speed_scale"/,/}/ s/.*"scale": *\([0-9.e+-]*\).*/\1/p' "$1"; }
+live_scale=$(learned "$summary"); offline_scale=$(learned "$work/offline_none/summary.json")
+echo "speed scale learned live ${live_scale}, offline ${offline_scale}"
+awk -v l="$live_scale" -v o="$offline_scale" 'BEGIN { exit !(l > 0.98 && l < 1.0 && (l - o) ^ 2 < 0.002 ^ 2) }' ||
+  { echo "FAIL: the live summary's speed scale ${live_scale} against offline ${offline_scale}"; exit 1; }
+grep -q 'odometry speed scale learned from NDT' "$work/localize_none.txt" || { echo "FAIL: the stop did not say what NDT taught"; exit 1; }
 
 # 2. An initial pose 5 m to the side.
 localize side "$work/sim/side.yaml"

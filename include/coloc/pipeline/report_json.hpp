@@ -21,5 +21,9 @@ std::string ndtJson(const ndt::NdtPoseSourceCounters& ndt, const ndt::DynamicMap
 std::string fixesJson(const std::map<std::string, rsu_client::FixCounters>& fixes, const std::map<std::string, fusion::SourceCounters>& filter);
 /// {state, reason, started_how, starts, recoveries, ..., events}
 std::string localizationJson(const PipelineReport& report);
+/// What NDT's poses taught and where they were widened: {ndt_travel_check, ndt_fix_agreement,
+/// ndt_quality_map, odometry_speed_scale, odometry_yaw_rate_bias, lidar_mount_yaw[,
+/// filter_odometry_states]}, the keys a summary.json has beside "ndt".
+std::string learnedJson(const PipelineReport& report);
 
 }  // namespace coloc::pipeline
