@@ -303,12 +303,6 @@ void drive(std::vector<Event>& events, const pipeline::Config& config, const Rep
   result.map = report.map;
   result.scans_without_guess = report.scans_without_guess;
   result.fixes = report.fixes;
-  result.speed_scale = report.speed_scale;
-  result.speed_scale_distance = report.speed_scale_distance;
-  result.yaw_rate_bias = report.yaw_rate_bias;
-  result.yaw_rate_bias_time = report.yaw_rate_bias_time;
-  result.mount_yaw = report.mount_yaw;
-  result.mount_yaw_distance = report.mount_yaw_distance;
 }
 
 }  // namespace

@@ -402,8 +402,10 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
   const ReplayResult by_direction = replayAgainstThePairsMap(
       dir / "scans", "  quality_map: " + (dir / "along.yaml") + "\n  quality_noise_by_direction: true\nfusion:\n  map_match_bias_sd: 0.1\n  odometry_scale_sd: 0.02\n");
   EXPECT_EQ(by_direction.pipeline_report.ndt_quality_raised, 3u) << "the fit's 1 cm along raised to the noise's 28 cm";
-  for (const auto& [key, covariance] : by_direction.claimedCovariances())
-    if (key.first == pipeline::kNdtSource) EXPECT_GE(std::min(covariance(0, 0), covariance(1, 1)), along.varianceAt(here) * (1.0 - 1e-9));
+  for (const auto& [key, covariance] : by_direction.claimedCovariances()) {
+    if (key.first != pipeline::kNdtSource) continue;
+    EXPECT_GE(std::min(covariance(0, 0), covariance(1, 1)), along.varianceAt(here) * (1.0 - 1e-9));
+  }
   // The same poses where the map's only cell lies elsewhere and its default is nothing: as NDT gave them.
   std::ofstream(dir / "elsewhere.yaml") << pipeline::NdtQualityMap::fromErrors({samples.begin() + 5, samples.end()}, 10.0, 5, 0.0).toYaml();
   EXPECT_EQ(replayAgainstThePairsMap(dir / "scans", "  quality_map: " + (dir / "elsewhere.yaml") + "\n").pipeline_report.ndt_quality_raised, 0u);

@@ -81,12 +81,6 @@ struct ReplayResult {
   std::vector<std::pair<std::string, TwistMeasurement>> received_twists;  ///< the same twists as the log has them
   std::vector<std::pair<Stamp, Vector6d>> fused_states;
   std::vector<Matrix6d> fused_state_covariances;  ///< beside fused_states
-  double speed_scale = 1.0;           ///< the odometry's speed scale learned from NDT
-  double speed_scale_distance = 0.0;  ///< m of travel it was learned over
-  double yaw_rate_bias = 0.0;         ///< rad/s, the odometry's yaw-rate bias learned from NDT
-  double yaw_rate_bias_time = 0.0;    ///< s it was learned over
-  double mount_yaw = 0.0;             ///< rad, the LiDAR's mounting yaw learned from NDT
-  double mount_yaw_distance = 0.0;    ///< m it was learned over
 
   /// Everything that follows from the log and the config, as JSON (summary.json of `coloc fuse`): the
   /// same log and config give the same bytes. `log` is the name to print for the recording.
