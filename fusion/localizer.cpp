@@ -222,8 +222,9 @@ struct Localizer::Impl {
       c.nis_below += d2 < nis_band[record.m].first ? 1 : 0;
       const std::array<double, kNisComponents>& parts = normalized.components;
       for (std::size_t k = 0; k < parts.size(); ++k) {
-        if (!std::isfinite(parts[k])) continue;
+        if (!std::isfinite(parts[k]) || !std::isfinite(normalized.prediction_share[k])) continue;
         c.nis_component_sum[k] += parts[k];
+        c.nis_prediction_share_sum[k] += normalized.prediction_share[k];
         ++c.nis_component_samples[k];
       }
     }

@@ -154,34 +154,39 @@ Innovation innovation(const FilterState& state, const UpdateRecord& record, doub
 
 namespace {
 
-// Each measured component's e_i^2 / S_ii alone, x and y turned to along and across the state's yaw.
-std::array<double, kNisComponents> componentsOf(const FilterState& state, const UpdateRecord& record, const Innovation& in) {
-  std::array<double, kNisComponents> out;
-  out.fill(std::numeric_limits<double>::quiet_NaN());
-  const auto ratio = [](double e, double s) { return s > 0.0 ? e * e / s : std::numeric_limits<double>::quiet_NaN(); };
+// Each measured component's e_i^2 / S_ii and (H P H')_ii / S_ii; x and y turned into the vehicle's
+// frame first (along = (cos, sin) . e, across = (-sin, cos) . e), where a road's weak direction lies.
+void componentsOf(const FilterState& state, const UpdateRecord& record, const Innovation& in, NormalizedInnovation& out) {
+  out.components.fill(std::numeric_limits<double>::quiet_NaN());
+  out.prediction_share.fill(std::numeric_limits<double>::quiet_NaN());
+  const auto set = [&](int k, double e, double s, double r) {
+    if (!(s > 0.0)) return;
+    out.components[k] = e * e / s;
+    out.prediction_share[k] = (s - r) / s;
+  };
   int row_x = -1, row_y = -1;
   for (int i = 0; i < in.m; ++i) {
     const int si = record.index[i];
     if (si == kX) row_x = i;
     if (si == kY) row_y = i;
-    if (si == kYaw) out[kNisYaw] = ratio(in.e[i], in.S(i, i));
-    if (si == kVx) out[kNisSpeed] = ratio(in.e[i], in.S(i, i));
-    if (si == kWz) out[kNisYawRate] = ratio(in.e[i], in.S(i, i));
+    if (si == kYaw) set(kNisYaw, in.e[i], in.S(i, i), record.R(i, i));
+    if (si == kVx) set(kNisSpeed, in.e[i], in.S(i, i), record.R(i, i));
+    if (si == kWz) set(kNisYawRate, in.e[i], in.S(i, i), record.R(i, i));
   }
   if (row_x >= 0 && row_y >= 0) {
-    // Turned into the vehicle's frame: along = (cos, sin) . e, across = (-sin, cos) . e.
     const double c = std::cos(state.x[kYaw]), s = std::sin(state.x[kYaw]);
-    const Eigen::Vector2d e(in.e[row_x], in.e[row_y]);
-    Eigen::Matrix2d S;
-    S << in.S(row_x, row_x), in.S(row_x, row_y), in.S(row_y, row_x), in.S(row_y, row_y);
     Eigen::Matrix2d turn;
     turn << c, s, -s, c;
-    const Eigen::Vector2d e_body = turn * e;
-    const Eigen::Matrix2d S_body = turn * S * turn.transpose();
-    out[kNisAlong] = ratio(e_body.x(), S_body(0, 0));
-    out[kNisAcross] = ratio(e_body.y(), S_body(1, 1));
+    const auto block = [&](const Eigen::Matrix3d& m) {
+      Eigen::Matrix2d b;
+      b << m(row_x, row_x), m(row_x, row_y), m(row_y, row_x), m(row_y, row_y);
+      return Eigen::Matrix2d(turn * b * turn.transpose());
+    };
+    const Eigen::Vector2d e_body = turn * Eigen::Vector2d(in.e[row_x], in.e[row_y]);
+    const Eigen::Matrix2d S_body = block(in.S), R_body = block(record.R);
+    set(kNisAlong, e_body.x(), S_body(0, 0), R_body(0, 0));
+    set(kNisAcross, e_body.y(), S_body(1, 1), R_body(1, 1));
   }
-  return out;
 }
 
 }  // namespace
@@ -189,9 +194,10 @@ std::array<double, kNisComponents> componentsOf(const FilterState& state, const 
 NormalizedInnovation normalizedInnovation(const FilterState& state, const UpdateRecord& record) {
   NormalizedInnovation out;
   out.components.fill(std::numeric_limits<double>::quiet_NaN());
+  out.prediction_share.fill(std::numeric_limits<double>::quiet_NaN());
   if (record.m == 0) return out;
   const Innovation in = innovation(state, record, 1.0);
-  out.components = componentsOf(state, record, in);
+  componentsOf(state, record, in, out);
   Eigen::Matrix<double, 3, 1> solved = Eigen::Matrix<double, 3, 1>::Zero();
   if (!solveSpd<1>(in.S, in.m, in.e, solved)) {
     out.d2 = kInfinity;

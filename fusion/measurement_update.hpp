@@ -42,6 +42,8 @@ Innovation innovation(const FilterState& state, const UpdateRecord& record, doub
 struct NormalizedInnovation {
   double d2 = 0.0;
   std::array<double, kNisComponents> components{};
+  /// Each component's (H P H')_ii / S_ii: the share of its S that is the state's (NaN where not measured).
+  std::array<double, kNisComponents> prediction_share{};
 };
 NormalizedInnovation normalizedInnovation(const FilterState& state, const UpdateRecord& record);
 

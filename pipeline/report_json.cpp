@@ -27,7 +27,10 @@ std::string sourcesJson(const std::vector<fusion::SourceReport>& sources) {
       if (n == 0) continue;
       const auto part_band = fusion::nisBand(n);
       parts[fusion::toString(static_cast<fusion::NisComponent>(k))] = {
-          {"samples", n}, {"mean", c.nis_component_sum[k] / static_cast<double>(n)}, {"band_95", {part_band.first, part_band.second}}};
+          {"samples", n},
+          {"mean", c.nis_component_sum[k] / static_cast<double>(n)},
+          {"band_95", {part_band.first, part_band.second}},
+          {"prediction_share", c.nis_prediction_share_sum[k] / static_cast<double>(n)}};
     }
     nis["per_component"] = parts;
     list.push_back({{"name", s.name}, {"kind", s.kind == fusion::SourceKind::kPose ? "pose" : "twist"}, {"counters", counters}, {"nis", nis}});

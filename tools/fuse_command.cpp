@@ -62,12 +62,13 @@ void printSummary(const std::string& log, const ReplayResult& r, const std::stri
     std::string parts;
     for (std::size_t k = 0; k < c.nis_component_sum.size(); ++k) {
       if (!c.nis_component_samples[k]) continue;
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%s%s %.3g", parts.empty() ? "" : ", ", fusion::toString(static_cast<fusion::NisComponent>(k)),
-                    c.nis_component_sum[k] / static_cast<double>(c.nis_component_samples[k]));
+      char buf[96];
+      const double n = static_cast<double>(c.nis_component_samples[k]);
+      std::snprintf(buf, sizeof buf, "%s%s %.3g (S %.0f %% prediction)", parts.empty() ? "" : ", ",
+                    fusion::toString(static_cast<fusion::NisComponent>(k)), c.nis_component_sum[k] / n, 100.0 * c.nis_prediction_share_sum[k] / n);
       parts += buf;
     }
-    if (!parts.empty()) std::printf("  %-22s %8s %s\n", "", "", (parts + " (each component alone)").c_str());
+    if (!parts.empty()) std::printf("  %-22s %8s %s\n", "", "", (parts + " (each component alone; the share of its S that is the filter's prediction, not the source's covariance)").c_str());
   }
   for (const auto& [id, c] : r.fixes) std::printf("  %s\n", fixLine(id, r.pipeline_report).c_str());
   std::printf("  localization: %s\n", localizationLine(r.pipeline_report).c_str());

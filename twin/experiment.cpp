@@ -263,7 +263,8 @@ void runJob(Job& job) {
     if (s.name == pipeline::kNdtSource) {
       job.run.ndt_nis_sum = s.counters.nis_sum, job.run.ndt_nis_dof = s.counters.nis_dof;
       for (std::size_t k = 0; k < job.run.ndt_nis_component_sum.size(); ++k)
-        job.run.ndt_nis_component_sum[k] = s.counters.nis_component_sum[k], job.run.ndt_nis_component_samples[k] = s.counters.nis_component_samples[k];
+        job.run.ndt_nis_component_sum[k] = s.counters.nis_component_sum[k], job.run.ndt_nis_component_samples[k] = s.counters.nis_component_samples[k],
+        job.run.ndt_nis_prediction_share_sum[k] = s.counters.nis_prediction_share_sum[k];
     }
   for (const fusion::SourceReport& s : r.sources)
     if (std::find(job.fix_sources.begin(), job.fix_sources.end(), s.name) != job.fix_sources.end()) {

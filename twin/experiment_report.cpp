@@ -496,7 +496,7 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
     }
     // NDT's normalized innovation squared per site and configuration, the main drives' ideal network.
     std::map<std::pair<std::string, std::string>, std::pair<double, std::uint64_t>> nis;
-    std::map<std::pair<std::string, std::string>, std::array<std::pair<double, std::uint64_t>, 3>> nis_parts;
+    std::map<std::pair<std::string, std::string>, std::array<std::pair<double, std::uint64_t>, 3>> nis_parts, nis_shares;
     std::set<std::string> present;
     for (const ExperimentRun& r : results.runs) {
       if (!r.variant.empty() || r.delay != 0.0 || r.loss != 0.0 || r.ndt_nis_dof == 0) continue;
@@ -506,6 +506,8 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
       n.second += r.ndt_nis_dof;
       auto& parts = nis_parts[{r.site, configuration}];
       for (std::size_t k = 0; k < parts.size(); ++k) parts[k].first += r.ndt_nis_component_sum[k], parts[k].second += r.ndt_nis_component_samples[k];
+      auto& shares = nis_shares[{r.site, configuration}];
+      for (std::size_t k = 0; k < shares.size(); ++k) shares[k].first += r.ndt_nis_prediction_share_sum[k], shares[k].second += r.ndt_nis_component_samples[k];
       present.insert(configuration);
     }
     std::vector<std::string> configurations;  // NDT only first, then each LiDAR as configured
@@ -542,6 +544,17 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         if (found == nis_parts.end()) return std::string("-");
         std::string cell;
         for (const auto& [sum, n] : found->second) cell += (cell.empty() ? "" : " / ") + (n ? fmt("%.3g", sum / static_cast<double>(n)) : std::string("-"));
+        return cell;
+      });
+      // Where S is mostly the filter's own prediction, NDT's covariance hardly enters its figure: the
+      // figure then measures the prediction (the odometry's stated covariance, the process noise).
+      ndt_md << "\nThe share of each component's S that is the filter's prediction, (H P H')_ii / S_ii, not NDT's covariance: along / "
+                "across / yaw:\n\n";
+      by_site([&](const std::string& site, const std::string& configuration) {
+        const auto found = nis_shares.find({site, configuration});
+        if (found == nis_shares.end()) return std::string("-");
+        std::string cell;
+        for (const auto& [sum, n] : found->second) cell += (cell.empty() ? "" : " / ") + (n ? fmt("%.0f %%", 100.0 * sum / static_cast<double>(n)) : std::string("-"));
         return cell;
       });
     }

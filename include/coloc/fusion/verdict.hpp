@@ -84,6 +84,10 @@ struct SourceCounters {
   /// too little and another too much, and a corridor's direction is along the road, not along x.
   std::array<double, kNisComponents> nis_component_sum{};
   std::array<std::uint64_t, kNisComponents> nis_component_samples{};
+  /// Each component's share of S that is the filter's own prediction, (H P H')_ii / S_ii, summed over
+  /// the same samples: near 1, the source's covariance hardly enters its NIS, which then says how
+  /// honest the prediction is (the odometry's stated covariance, the process noise) more than the source.
+  std::array<double, kNisComponents> nis_prediction_share_sum{};
 };
 
 /// The band the mean NIS per degree of freedom (nis_sum / nis_dof) lies in 95 % of the time when the

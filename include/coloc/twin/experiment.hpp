@@ -42,6 +42,8 @@ struct ExperimentRun {
   /// kNisYaw): e_i^2 / S_ii summed, and the poses that measured it.
   std::array<double, 3> ndt_nis_component_sum{};
   std::array<std::uint64_t, 3> ndt_nis_component_samples{};
+  /// And each component's share of S that is the filter's prediction, (H P H')_ii / S_ii, summed.
+  std::array<double, 3> ndt_nis_prediction_share_sum{};
 
   std::string label() const;  ///< "NDT only", "NDT + VLP-16", "NDT + VLP-16, 30 ms, 20 % loss"
 };
