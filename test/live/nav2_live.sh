@@ -3,7 +3,7 @@
 # A real ROS 2 recording localized live as offline: the nav2 TurtleBot drive (AMCL poses and wheel
 # odometry, header stamps on the simulator's clock while the player's /clock is the recorder's wall
 # clock) is fused by `coloc fuse`, then played by `coloc play` into `coloc localize --use-sim-time
-# --discover-inputs` with no map and no configuration, at twice its pace. The live track must lie within 3 cm (mean) of the
+# --discover-inputs` with no map and no configuration, at four times its pace. The live track must lie within 3 cm (mean) of the
 # offline one, over at least 80 % of the drive.
 set -euo pipefail
 coloc=$1
@@ -15,7 +15,7 @@ export ROS_LOCALHOST_ONLY=1
 "$coloc" fuse "$log" --out "$work/offline" > "$work/fuse.txt"
 bounded 150 "$work/localize.txt" "$coloc" localize --use-sim-time --discover-inputs --out "$work/live" --idle-exit 3 --duration 140 &
 localizer=$!
-bounded 130 "$work/play.txt" "$coloc" play "$log" --delay 3 --rate 2
+bounded 130 "$work/play.txt" "$coloc" play "$log" --delay 3 --rate 4
 wait "$localizer"
 grep -q 'subscribed to /amcl_pose (geometry_msgs/msg/PoseWithCovarianceStamped) as pose' "$work/localize.txt" ||
   { echo "FAIL: /amcl_pose was not taken as a pose source"; exit 1; }
