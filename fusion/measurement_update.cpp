@@ -193,9 +193,10 @@ void componentsOf(const FilterState& state, const UpdateRecord& record, const In
 
 NormalizedInnovation normalizedInnovation(const FilterState& state, const UpdateRecord& record) {
   NormalizedInnovation out;
-  out.components.fill(std::numeric_limits<double>::quiet_NaN());
-  out.prediction_share.fill(std::numeric_limits<double>::quiet_NaN());
-  if (record.m == 0) return out;
+  if (record.m == 0) {
+    componentsOf(state, record, Innovation{}, out);  // every component NaN: none measured
+    return out;
+  }
   const Innovation in = innovation(state, record, 1.0);
   componentsOf(state, record, in, out);
   Eigen::Matrix<double, 3, 1> solved = Eigen::Matrix<double, 3, 1>::Zero();

@@ -537,26 +537,25 @@ std::string writeExperimentReport(const ExperimentResults& results, const std::s
         const auto band = fusion::nisBand(found->second.second);
         return fmt("%.2f", found->second.first / static_cast<double>(found->second.second)) + fmt(" (%.2f-", band.first) + fmt("%.2f)", band.second);
       });
+      // A cell per site and configuration of the three components' means, "along / across / yaw".
+      const auto by_component = [&](const auto& sums, double scale, const char* format) {
+        by_site([&](const std::string& site, const std::string& configuration) {
+          const auto found = sums.find({site, configuration});
+          if (found == sums.end()) return std::string("-");
+          std::string cell;
+          for (const auto& [sum, n] : found->second)
+            cell += (cell.empty() ? "" : " / ") + (n ? fmt(format, scale * sum / static_cast<double>(n)) : std::string("-"));
+          return cell;
+        });
+      };
       // The whole figure can hide one direction trusted too little behind another trusted too much.
       ndt_md << "\nThe same per component (each e_i^2 / S_ii alone, 1 when honest): along the vehicle / across it / yaw:\n\n";
-      by_site([&](const std::string& site, const std::string& configuration) {
-        const auto found = nis_parts.find({site, configuration});
-        if (found == nis_parts.end()) return std::string("-");
-        std::string cell;
-        for (const auto& [sum, n] : found->second) cell += (cell.empty() ? "" : " / ") + (n ? fmt("%.3g", sum / static_cast<double>(n)) : std::string("-"));
-        return cell;
-      });
+      by_component(nis_parts, 1.0, "%.3g");
       // Where S is mostly the filter's own prediction, NDT's covariance hardly enters its figure: the
       // figure then measures the prediction (the odometry's stated covariance, the process noise).
       ndt_md << "\nThe share of each component's S that is the filter's prediction, (H P H')_ii / S_ii, not NDT's covariance: along / "
                 "across / yaw:\n\n";
-      by_site([&](const std::string& site, const std::string& configuration) {
-        const auto found = nis_shares.find({site, configuration});
-        if (found == nis_shares.end()) return std::string("-");
-        std::string cell;
-        for (const auto& [sum, n] : found->second) cell += (cell.empty() ? "" : " / ") + (n ? fmt("%.0f %%", 100.0 * sum / static_cast<double>(n)) : std::string("-"));
-        return cell;
-      });
+      by_component(nis_shares, 100.0, "%.0f %%");
     }
   }
 
