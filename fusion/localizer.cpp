@@ -40,7 +40,8 @@ void validate(const EkfConfig& c) {
   requireConfig(std::isfinite(c.integrity_anchor_mean_nis) && c.integrity_anchor_mean_nis > 0.0, "integrity_anchor_mean_nis", "must be finite and > 0");
   const std::pair<const char*, double> non_negative[] = {
       {"proc_stddev_yaw_c", c.proc_stddev_yaw_c},       {"proc_stddev_vx_c", c.proc_stddev_vx_c},
-      {"proc_stddev_wz_c", c.proc_stddev_wz_c},         {"z_filter_proc_dev", c.z_filter_proc_dev},
+      {"proc_stddev_wz_c", c.proc_stddev_wz_c},         {"yaw_bias_walk", c.yaw_bias_walk},
+      {"z_filter_proc_dev", c.z_filter_proc_dev},
       {"roll_filter_proc_dev", c.roll_filter_proc_dev}, {"pitch_filter_proc_dev", c.pitch_filter_proc_dev},
       {"threshold_observable_velocity_mps", c.threshold_observable_velocity_mps},
       {"future_tolerance", c.future_tolerance},         {"initial_yaw_bias_variance", c.initial_yaw_bias_variance},
@@ -64,7 +65,7 @@ HistoryOptions historyOptions(const EkfConfig& c) {
   HistoryOptions o;
   o.steps = c.history_steps;
   o.step = static_cast<Duration>(std::llround(1e9 / c.predict_frequency));
-  o.noise = {c.proc_stddev_yaw_c, c.proc_stddev_vx_c, c.proc_stddev_wz_c};
+  o.noise = {c.proc_stddev_yaw_c, c.proc_stddev_vx_c, c.proc_stddev_wz_c, c.enable_yaw_bias_estimation ? c.yaw_bias_walk : 0.0};
   o.aux_proc_dev = {c.z_filter_proc_dev, c.roll_filter_proc_dev, c.pitch_filter_proc_dev};
   o.relinearize = c.relinearize_on_replay;
   o.extra.bias_length = c.map_match_bias_length;

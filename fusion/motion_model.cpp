@@ -48,6 +48,7 @@ Matrix6d processNoise(const ProcessNoise& noise, double dt) {
   Q(kYaw, kYaw) = (noise.yaw_c * dt) * (noise.yaw_c * dt);
   Q(kVx, kVx) = (noise.vx_c * dt) * (noise.vx_c * dt);
   Q(kWz, kWz) = (noise.wz_c * dt) * (noise.wz_c * dt);
+  Q(kYawBias, kYawBias) = noise.yaw_bias_walk * noise.yaw_bias_walk * dt;
   return Q;
 }
 

@@ -14,6 +14,7 @@ struct ProcessNoise {
   double yaw_c = 0.005;
   double vx_c = 10.0;
   double wz_c = 5.0;
+  double yaw_bias_walk = 0.0;  ///< rad/sqrt(s): Q = walk^2 dt
 };
 
 /// x + f(x) dt; yaw wrapped to (-pi, pi].

@@ -199,7 +199,7 @@ struct Pipeline::Impl {
   bool clock_set = false;
   PipelineReport report;
   std::function<void(const fusion::Estimate&)> on_estimate;
-  std::function<void(const std::string&, const PoseMeasurement&)> on_pose_input;
+  std::function<void(const std::string&, const PoseMeasurement&)> on_pose_input, on_pose_weighed;
   std::function<void(const std::string&, const fusion::Estimate&)> on_pose_settled;
   struct Settling {
     std::string source;
@@ -231,7 +231,7 @@ struct Pipeline::Impl {
         yaw_rate_bias(yaw_rate_bias_config),
         mount_yaw(mount_yaw_config),
         travel_check(TravelCheckConfig{options.map.has_value() ? c.pipeline.travel_check_window : 0.0, c.pipeline.travel_check_tolerance,
-                                       c.pipeline.travel_check_tolerance_per_metre}),
+                                       c.pipeline.travel_check_tolerance_per_metre, 5.0, c.pipeline.travel_check_turn_tolerance}),
         fix_agreement(FixAgreementConfig{options.map.has_value() ? c.pipeline.fix_agreement_window : 0.0, c.pipeline.fix_agreement_tolerance}),
         cam_size{c.rsu.vehicle_length, c.rsu.vehicle_width, c.rsu.cam_size_step, c.rsu.cam_length, c.rsu.cam_width} {
     const Vector6d& e = c.ndt.source.lidar_pose;
@@ -480,6 +480,7 @@ struct Pipeline::Impl {
   // filter's bias state); what onPoseInput reports.
   fusion::Verdict feedPose(fusion::SourceId source, const PoseMeasurement& pose, const PoseMeasurement* alone = nullptr) {
     if (on_pose_input) on_pose_input(source_names[source], alone ? *alone : pose);
+    if (on_pose_weighed) on_pose_weighed(source_names[source], pose);
     const bool was_initialized = localizer.initialized();
     const fusion::Verdict v = localizer.feedPose(source, pose);
     if (!was_initialized && localizer.initialized()) emit(*localizer.estimate());
@@ -530,8 +531,41 @@ struct Pipeline::Impl {
     // Where the filter models those slow errors as states (fusion.odometry_scale_sd,
     // odometry_yaw_rate_bias_sd), the odometry is what the filter says it is, and the bias is loose
     // everywhere.
-    const double place = ndt_quality.varianceAt(pose.pose.position.head<2>());
+    const Eigen::Vector2d at = pose.pose.position.head<2>();
+    const double place = ndt_quality.varianceAt(at);
+    const bool at_noise = place > 0.0 && config.ndt.quality_floor == "noise";
+    // NDT's scan-to-scan noise here, along and across the vehicle turned to the map by NDT's own
+    // heading, and in yaw; a pose floored at it where its bias is followed or held apart.
+    const std::optional<Eigen::Matrix2d> noise = place > 0.0 && (at_noise || config.ndt.quality_noise_by_direction)
+                                                     ? ndt_quality.noiseAt(at, rollPitchYaw(pose.pose.orientation)[2])
+                                                     : std::nullopt;
+    const auto floorAtNoise = [&] {
+      if (!noise) return false;
+      const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
+      pose.covariance.topLeftCorner<2, 2>() = coveringAtLeast(xy, *noise);
+      if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_raised;
+      return true;
+    };
+    // At most what NDT was here on the reference drive, in each direction (and at least its noise):
+    // where the scene holds NDT only loosely its score's probes, half a metre apart, spread as if it
+    // held nothing (site E's open square: 0.03-0.14 m^2 along the road, where its innovations were
+    // 1e-4), and trusted at that NDT's poses count for nothing along the road and its figure there
+    // is 0.1-0.3. In a cutting the reference drive's error is NDT's slide and the cap stays high.
+    const auto capAtError = [&] {
+      const std::optional<Eigen::Matrix2d> error = ndt_quality.errorAt(at, rollPitchYaw(pose.pose.orientation)[2]);
+      if (!noise || !error) return;
+      const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
+      pose.covariance.topLeftCorner<2, 2>() = coveringAtLeast(coveredAtMost(xy, *error), *noise);
+      if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_lowered;
+    };
     double floor = place;
+    if (at_noise) {
+      // The bias NDT's poses share is followed where nothing tells it apart: each pose counts only
+      // what is its own. Where the map measured no noise by direction, its noise per axis.
+      floor = floorAtNoise() ? 0.0 : ndt_quality.noiseVariance();
+      capAtError();
+      if (const std::optional<double> yaw = ndt_quality.yawNoiseAt(at)) pose.covariance(5, 5) = std::max(pose.covariance(5, 5), *yaw);
+    }
     const std::optional<fusion::Estimate> now = localizer.estimate();
     if (config.fusion.map_match_bias_sd > 0.0) {
       const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
@@ -540,14 +574,7 @@ struct Pipeline::Impl {
       if (told_apart) {
         spread = config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
         if (place > 0.0) floor = ndt_quality.noiseVariance(), spread = std::max(place - floor, 0.0);
-        // The noise along the vehicle and across it, turned to the map by NDT's own heading.
-        const std::optional<Eigen::Matrix2d> noise = place > 0.0 && config.ndt.quality_noise_by_direction
-                                                         ? ndt_quality.noiseAt(rollPitchYaw(pose.pose.orientation)[2])
-                                                         : std::nullopt;
-        if (noise) {
-          const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
-          pose.covariance.topLeftCorner<2, 2>() = coveringAtLeast(xy, *noise);
-          if (pose.covariance.topLeftCorner<2, 2>() != xy) ++report.ndt_quality_raised;
+        if (noise && (at_noise || floorAtNoise())) {
           spread = std::max(place - 0.5 * noise->trace(), 0.0);
           floor = 0.0;
         }
@@ -579,6 +606,11 @@ struct Pipeline::Impl {
       for (PoseMeasurement* p : {&pose, &alone}) p->covariance.topLeftCorner<2, 2>() += *excess * excess->transpose();
       ++report.ndt_travel_disagreements;
       report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
+    }
+    if (const double turn = travel_check.turnExcess(); turn > 0.0) {
+      for (PoseMeasurement* p : {&pose, &alone}) p->covariance(5, 5) += turn * turn;
+      ++report.ndt_turn_disagreements;
+      report.ndt_turn_max_excess = std::max(report.ndt_turn_max_excess, turn);
     }
     // Where the roadside's fixes disagree with NDT's position, its pose is worth no more than that.
     if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), yaw, place); off && off->squaredNorm() > 0.0) {
@@ -650,6 +682,10 @@ struct Pipeline::Impl {
       if (std::isfinite(t.covariance(0, 0))) {
         speed_scale.addTwist(t.stamp, t.linear.x());
         t.linear.x() *= speed_scale.scale();
+        if (config.pipeline.speed_scale_uncertainty && speed_scale_config.enabled) {
+          const double doubt = speed_scale.scaleSd() * t.linear.x();
+          t.covariance(0, 0) += doubt * doubt;
+        }
         travel_check.addSpeed(t.stamp, t.linear.x());
         fix_agreement.addSpeed(t.stamp, t.linear.x());
       }
@@ -828,6 +864,10 @@ void Pipeline::onEstimate(std::function<void(const fusion::Estimate&)> callback)
 void Pipeline::onPoseSettled(std::function<void(const std::string&, const fusion::Estimate&)> callback) {
   std::lock_guard<std::mutex> lock(impl_->state_mutex);
   impl_->on_pose_settled = std::move(callback);
+}
+
+void Pipeline::onPoseWeighed(std::function<void(const std::string&, const PoseMeasurement&)> callback) {
+  impl_->on_pose_weighed = std::move(callback);
 }
 
 void Pipeline::onPoseInput(std::function<void(const std::string&, const PoseMeasurement&)> callback) {

@@ -92,9 +92,10 @@ std::string localizationJson(const PipelineReport& r) {
 std::string learnedJson(const PipelineReport& r) {
   nlohmann::ordered_json j;
   j["ndt_travel_check"] = {{"disagreements", r.ndt_travel_disagreements}, {"max_excess_m", r.ndt_travel_max_excess},
-                           {"unverified", r.ndt_travel_unverified}};
+                           {"unverified", r.ndt_travel_unverified}, {"turn_disagreements", r.ndt_turn_disagreements},
+                           {"turn_max_excess_rad", r.ndt_turn_max_excess}};
   j["ndt_fix_agreement"] = {{"disagreements", r.ndt_fix_disagreements}, {"max_excess_m", r.ndt_fix_max_excess}};
-  j["ndt_quality_map"] = {{"raised", r.ndt_quality_raised}};
+  j["ndt_quality_map"] = {{"raised", r.ndt_quality_raised}, {"lowered", r.ndt_quality_lowered}};
   j["odometry_speed_scale"] = {{"scale", r.speed_scale}, {"compared_m", r.speed_scale_distance}};
   j["odometry_yaw_rate_bias"] = {{"bias_rad_s", r.yaw_rate_bias}, {"compared_s", r.yaw_rate_bias_time}};
   j["lidar_mount_yaw"] = {{"yaw_rad", r.mount_yaw}, {"compared_m", r.mount_yaw_distance}};

@@ -31,6 +31,7 @@ void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position, 
     const double floor = config_.pose_sd_floor * config_.pose_sd_floor;
     weight = 2.0 * floor / (2.0 * floor + anchor_->sd * anchor_->sd + sd * sd);
   }
+  const double anchor_sd = anchor_->sd;
   anchor_ = here;
   const double ratio = chord / travelled;
   if (!(std::abs(ratio - 1.0) <= 3.0 * config_.max_error)) return;  // a jump of NDT, not a scale
@@ -38,9 +39,16 @@ void SpeedScaleEstimator::addPose(Stamp stamp, const Eigen::Vector2d& position, 
   const double keep = std::exp(-travelled / config_.memory);
   weighted_pose_ = keep * weighted_pose_ + weight * chord;
   weighted_odometry_ = keep * weighted_odometry_ + weight * travelled;
+  const double floor = config_.pose_sd_floor * config_.pose_sd_floor;
+  weighted_variance_ = keep * keep * weighted_variance_ + weight * weight * std::max(anchor_sd * anchor_sd + sd * sd, 2.0 * floor);
   compared_ += travelled;
   const double estimate = weighted_pose_ / weighted_odometry_;
   if (std::abs(estimate - 1.0) <= config_.max_error) estimate_ = estimate;
+}
+
+double SpeedScaleEstimator::scaleSd() const {
+  if (!usable() || !(weighted_odometry_ > 0.0)) return config_.prior_sd;
+  return std::sqrt(weighted_variance_) / weighted_odometry_;
 }
 
 }  // namespace coloc::pipeline

@@ -33,6 +33,8 @@ struct SpeedScaleConfig {
   /// road (site D's cutting: 0.2-0.9 m stated) its chords read its slide, which it took from the
   /// filter's own guess, not the wheels. <= 0: every chord counts by its length alone.
   double pose_sd_floor = 0.01;
+  /// The scale's standard deviation before it is usable: a wheel radius's error (0.5-2 %).
+  double prior_sd = 0.02;
 };
 
 class SpeedScaleEstimator {
@@ -47,6 +49,10 @@ class SpeedScaleEstimator {
   /// True speed per measured speed; 1 until enough travel was compared.
   double scale() const { return usable() ? estimate_ : 1.0; }
   bool usable() const { return config_.enabled && compared_ >= config_.min_distance; }
+  /// The standard deviation of scale(): prior_sd until usable, then the chords' own, each chord's
+  /// error its two ends' stated variances (at least pose_sd_floor each) over the weighted travel, the
+  /// chords taken as independent (consecutive chords share an end, so this is the larger figure).
+  double scaleSd() const;
   double comparedDistance() const { return compared_; }
 
  private:
@@ -61,6 +67,7 @@ class SpeedScaleEstimator {
   std::optional<Anchor> anchor_;
   std::optional<Anchor> candidate_;  ///< a first anchor waiting for its successor's word
   double weighted_pose_ = 0.0, weighted_odometry_ = 0.0;       ///< forgetful sums of chord lengths
+  double weighted_variance_ = 0.0;                               ///< forgetful sum of the chords' weighted error variances, m^2
   double estimate_ = 1.0, compared_ = 0.0;
 };
 

@@ -152,7 +152,7 @@ pipeline::NdtQualityMap ndtQualityMap(const std::vector<ErrorSample>& ndt, doubl
     // A sample the map cannot place (not finite, or beyond the 1e9 m it indexes) says nothing about any place: left out, not an error
     // that would stop `coloc fuse` after its replay.
     if (!s.estimate.allFinite() || !s.truth.allFinite() || s.estimate.cwiseAbs().maxCoeff() > 1e9) continue;
-    samples.push_back({s.estimate, s.estimate - s.truth, s.truth_heading});
+    samples.push_back({s.estimate, s.estimate - s.truth, s.truth_heading, s.heading_error});
   }
   return pipeline::NdtQualityMap::fromErrors(samples, cell, min_poses);  // elsewhere the drive's own mean square
 }

@@ -274,6 +274,7 @@ void drive(std::vector<Event>& events, const pipeline::Config& config, const Rep
     result.pose_input_covariances.push_back(p.covariance.topLeftCorner<2, 2>());
     if (keep) result.filter_poses.emplace_back(source, p);
   });
+  if (keep) pipe.onPoseWeighed([&](const std::string& source, const PoseMeasurement& p) { result.weighed_poses.emplace_back(source, p); });
   if (keep)
     pipe.onTwistInput([&](const std::string& source, const TwistMeasurement& handed, const TwistMeasurement& received) {
       result.filter_twists.emplace_back(source, handed);

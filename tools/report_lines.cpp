@@ -53,11 +53,16 @@ std::string learnedLines(const pipeline::PipelineReport& r) {
   line(out, "  NDT's travel against the odometry's: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m), "
             "%llu had none to compare yet\n",
        (unsigned long long)r.ndt_travel_disagreements, r.ndt_travel_max_excess, (unsigned long long)r.ndt_travel_unverified);
+  if (r.ndt_turn_disagreements > 0)
+    line(out, "  NDT's turn against the yaw rate's: %llu poses disagreed beyond the tolerance (yaw variance widened; largest by %.4f rad)\n",
+         (unsigned long long)r.ndt_turn_disagreements, r.ndt_turn_max_excess);
   if (r.ndt_fix_disagreements > 0)
     line(out, "  NDT's position against the roadside's fixes: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m)\n",
          (unsigned long long)r.ndt_fix_disagreements, r.ndt_fix_max_excess);
   if (r.ndt_quality_raised > 0)
     line(out, "  NDT's error by place (ndt.quality_map): %llu poses' covariance raised to their place's figure\n", (unsigned long long)r.ndt_quality_raised);
+  if (r.ndt_quality_lowered > 0)
+    line(out, "  NDT's error by place (ndt.quality_map): %llu poses' covariance taken down to what NDT was there\n", (unsigned long long)r.ndt_quality_lowered);
   line(out, "  odometry speed scale learned from NDT: %.4f over %.0f m (twists corrected by it)\n", r.speed_scale, r.speed_scale_distance);
   line(out, "  odometry yaw-rate bias learned from NDT: %.5f rad/s over %.0f s (twists corrected by it)\n", r.yaw_rate_bias, r.yaw_rate_bias_time);
   line(out, "  LiDAR mounting yaw learned from NDT: %.3f deg over %.0f m (NDT's poses corrected by it)\n", r.mount_yaw * 180.0 / M_PI, r.mount_yaw_distance);

@@ -139,6 +139,78 @@ TEST(NdtQualityMap, AScanMatchedFarOffIsLeftOutOfItsPlaceAndOfTheScanToScanNoise
   EXPECT_THROW(NdtQualityMap::grossErrors({{{std::nan(""), 0.0}, {0.0, 0.0}}}, 10.0), Error);
 }
 
+// NDT's noise changes with the place as much as its error does (site D's cutting: 50x its median
+// cell along the road). Each cell measures its own noise along, across and in yaw, and its error
+// along and across; a cell with few pairs is drawn towards the median cell, not towards the map's
+// mean, which the cutting decides.
+TEST(NdtQualityMap, EachCellMeasuresItsOwnNoiseAndErrorDrawnTowardsTheMedianCell) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<NdtQualitySample> s;
+  // Eastward, 0.1 m apart over 200 m: 20 cells of 100 pairs. NDT 5 cm ahead and 2 cm to the left
+  // everywhere, its noise 1 cm along, 1 mm across and 0.3 mrad in yaw, except in cells 5 and 6 (a
+  // cutting) where it is 10 cm along.
+  for (int i = 0; i < 2000; ++i) {
+    const double x = 0.1 * i + 0.05, along = (x >= 50.0 && x < 70.0) ? 0.10 : 0.01;
+    s.push_back({{x, 5.0}, {0.05 + along * unit(rng), 0.02 + 0.001 * unit(rng)}, 0.0, 0.003 + 3e-4 * unit(rng)});
+  }
+  // Three pairs in a cell of their own, 100 m north, with no noise at all.
+  for (int i = 0; i < 4; ++i) s.push_back({{5.0 + 0.1 * i, 105.0}, {0.05, 0.02}, 0.0, 0.003});
+  const NdtQualityMap m = NdtQualityMap::fromErrors(s, 10.0, 3, 0.0);
+  ASSERT_TRUE(m.noiseAlongAcross() && m.yawNoise());
+  EXPECT_GT(m.noiseAlongAcross()->x(), 8e-4) << "the map's figure, a mean: the cutting decides it";
+  // Heading east: along is x. 100 pairs give each cell's variance within 14 % (1 sd).
+  const Eigen::Matrix2d open = *m.noiseAt({25.0, 5.0}, 0.0), cutting = *m.noiseAt({55.0, 5.0}, 0.0);
+  EXPECT_NEAR(open(0, 0), 1e-4, 0.45e-4);
+  EXPECT_NEAR(open(1, 1), 1e-6, 0.45e-6);
+  EXPECT_NEAR(cutting(0, 0), 1e-2, 0.45e-2);
+  EXPECT_NEAR(*m.yawNoiseAt({25.0, 5.0}), 9e-8, 4e-8);
+  // Heading north the same cell's noise along is on y.
+  EXPECT_NEAR((*m.noiseAt({25.0, 5.0}, M_PI / 2.0))(1, 1), open(0, 0), 1e-15);
+  // The quiet cell's three pairs, drawn towards the median cell's 1e-4: 5 / 8 of it, where the
+  // map's mean would have made it 5 / 8 of 1e-3.
+  EXPECT_NEAR((*m.noiseAt({5.0, 105.0}, 0.0))(0, 0), 5.0 / 8.0 * 1e-4, 0.3e-4);
+  // Its error: the mean square, the bias in it, along and across.
+  const Eigen::Matrix2d error = *m.errorAt({25.0, 5.0}, 0.0);
+  EXPECT_NEAR(error(0, 0), 0.0025 + 1e-4, 0.0004);
+  EXPECT_NEAR(error(1, 1), 0.0004 + 1e-6, 0.00005);
+  // Where no cell measured: the map's figures, and no error by direction.
+  EXPECT_NEAR((*m.noiseAt({500.0, 500.0}, 0.0))(0, 0), m.noiseAlongAcross()->x(), 1e-15);
+  EXPECT_EQ(*m.yawNoiseAt({500.0, 500.0}), *m.yawNoise());
+  EXPECT_FALSE(m.errorAt({500.0, 500.0}, 0.0));
+  EXPECT_FALSE(m.errorAt({25.0, 5.0}, std::nan("")));
+  // The file carries all of it.
+  const NdtQualityMap read = NdtQualityMap::parse(m.toYaml(), "q.yaml");
+  for (const Eigen::Vector2d& at : {Eigen::Vector2d(25.0, 5.0), Eigen::Vector2d(55.0, 5.0), Eigen::Vector2d(5.0, 105.0)}) {
+    EXPECT_TRUE(read.noiseAt(at, 0.3)->isApprox(*m.noiseAt(at, 0.3), 1e-12));
+    EXPECT_TRUE(read.errorAt(at, 0.3)->isApprox(*m.errorAt(at, 0.3), 1e-12));
+    EXPECT_NEAR(*read.yawNoiseAt(at), *m.yawNoiseAt(at), 1e-20);
+  }
+  // Samples without NDT's yaw error measure no cell's noise: the map's along and across serve.
+  for (NdtQualitySample& sample : s) sample.yaw_error = std::nan("");
+  const NdtQualityMap no_yaw = NdtQualityMap::fromErrors(s, 10.0, 3, 0.0);
+  EXPECT_FALSE(no_yaw.yawNoise());
+  EXPECT_NEAR((*no_yaw.noiseAt({55.0, 5.0}, 0.0))(0, 0), no_yaw.noiseAlongAcross()->x(), 1e-15);
+}
+
+TEST(NdtQualityMap, ACellsNoiseThatCannotBeIsRefusedNamingTheCell) {
+  const std::string head = "cell: 10\ndefault_variance: 0.01\nnoise_variance: 1e-4\nnoise_along: 1e-4\nnoise_across: 1e-6\nnoise_yaw: 1e-7\ncells:\n";
+  EXPECT_NO_THROW(NdtQualityMap::parse(head + "  - [0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, 1e-6, 1e-7]\n", "q.yaml"));
+  for (const std::string row : {"[0, 0, 10, 1e-3, 2e-3, 1e-5, 0, 1e-4, 1e-6, 1e-7]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, 11, 1e-4, 1e-6, 1e-7]",
+                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 2.5, 1e-4, 1e-6, 1e-7]", "[0, 0, 10, 1e-3, -2e-3, 1e-5, 9, 1e-4, 1e-6, 1e-7]",
+                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, .nan, 1e-7]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, 1e-6, .inf]",
+                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4]"}) {
+    try {
+      NdtQualityMap::parse(head + "  - " + row + "\n", "q.yaml");
+      ADD_FAILURE() << row << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("q.yaml:8: cells[0]"), std::string::npos) << e.what();
+    }
+  }
+  // A cell's noise without the map's to fall back on.
+  EXPECT_THROW(NdtQualityMap::parse("cell: 10\ndefault_variance: 0.01\ncells:\n  - [0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, 1e-6, 1e-7]\n", "q.yaml"), Error);
+}
+
 TEST(NdtQualityMap, ItsFileReadsBackToTheSameMap) {
   const NdtQualityMap m = NdtQualityMap::fromErrors(twoPlaces(), 10.0, 5, 0.004);
   const NdtQualityMap back = NdtQualityMap::parse(m.toYaml(), "q.yaml");

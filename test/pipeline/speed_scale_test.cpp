@@ -105,5 +105,37 @@ TEST(SpeedScale, AnNdtJumpIsNotTakenForAScale) {
   EXPECT_NEAR(e.scale(), 1.0 / 1.01, 0.002);
 }
 
+// The scale's doubt, which pipeline.speed_scale_uncertainty adds to each twist's speed variance: a
+// wheel's 2 % until one chord was compared, then what the chords say, which shrinks with the travel
+// and covers the scale's real error (20 drives, NDT stating its 2 cm honestly).
+TEST(SpeedScale, ItsStandardDeviationIsThePriorUntilUsableThenShrinksWithTravelAndCoversItsError) {
+  double squares = 0.0, worst = 0.0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    SpeedScaleEstimator e;
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> odometry_noise(0.0, 0.05), pose_noise(0.0, 0.02);
+    double at_two = 0.0;
+    for (int k = 0; k * 0.02 <= 20.0; ++k) {
+      const double t = k * 0.02;
+      e.addTwist(kStart + static_cast<Stamp>(t * 1e9), 10.0 * 1.01 + odometry_noise(rng));
+      if (k % 5 == 0) e.addPose(kStart + static_cast<Stamp>(t * 1e9), Eigen::Vector2d(10.0 * t + pose_noise(rng), pose_noise(rng)), 0.02);
+      if (k == 10) {
+        ASSERT_FALSE(e.usable());
+        EXPECT_EQ(e.scaleSd(), 0.02) << "the prior before a chord was compared";
+      }
+      if (k == 100) at_two = e.scaleSd();
+    }
+    ASSERT_TRUE(e.usable());
+    EXPECT_LT(e.scaleSd(), 0.5 * at_two) << "200 m against 20: the doubt shrinks with the travel";
+    EXPECT_LT(e.scaleSd(), 0.002);
+    const double z = (e.scale() - 1.0 / 1.01) / e.scaleSd();
+    squares += z * z / 20.0, worst = std::max(worst, std::abs(z));
+  }
+  // Consecutive chords share an end, so the figure is the larger one: the errors within it.
+  EXPECT_LT(worst, 3.0);
+  EXPECT_LT(std::sqrt(squares), 1.2);
+  EXPECT_GT(std::sqrt(squares), 0.05) << "not so loose that it says nothing";
+}
+
 }  // namespace
 }  // namespace coloc::pipeline

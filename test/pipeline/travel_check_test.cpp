@@ -206,5 +206,43 @@ TEST(TravelCheck, AWindowOfZeroTurnsTheCheckOff) {
   }
 }
 
+// NDT's heading held against the gyro's turn (travel_check_turn_tolerance): a scan matched a few
+// milliradians off is widened in yaw by the whole turn it disagrees by, which its x and y check does
+// not see; the gyro's own noise over a chord stays within the tolerance, and with the check off
+// nothing is widened.
+TEST(TravelCheck, AHeadingThatStepsAgainstTheGyrosTurnIsWidenedByTheWholeTurn) {
+  const auto run = [](double tolerance, std::vector<double>& turns) {
+    TravelCheckConfig config;
+    config.turn_tolerance = tolerance;
+    TravelCheck check(config);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> gyro_noise(0.0, 0.005), yaw_noise(0.0, 3e-4);
+    for (int k = 0; k * 0.02 <= 4.0; ++k) {
+      const double t = k * 0.02, rate = 0.1;  // a gentle bend, 10 m/s
+      check.addSpeed(at(t), 10.0);
+      check.addYawRate(at(t), rate + gyro_noise(rng));
+      if (k % 5 == 0) {
+        const double yaw = rate * t + yaw_noise(rng) + (t >= 2.0 && t < 2.45 ? 0.006 : 0.0);  // NDT's heading 6 mrad off for 0.4 s
+        const Eigen::Vector2d p = (10.0 / rate) * Eigen::Vector2d(std::sin(rate * t), 1.0 - std::cos(rate * t));
+        check.check(at(t), p, yaw);
+        turns.push_back(check.turnExcess());
+      }
+    }
+  };
+  std::vector<double> on, off;
+  run(0.002, on);
+  run(0.0, off);
+  for (std::size_t i = 0; i < off.size(); ++i) EXPECT_EQ(off[i], 0.0) << i;
+  ASSERT_EQ(on.size(), 41u);
+  for (std::size_t i = 0; i < on.size(); ++i) {
+    const double t = 0.1 * static_cast<double>(i);
+    if (t >= 2.0 - 1e-9 && t < 2.45) {
+      EXPECT_NEAR(on[i], 0.006, 0.0015) << "the step, whole, at " << t << " s";
+    } else if (t < 1.95 || t > 3.55) {
+      EXPECT_EQ(on[i], 0.0) << "the gyro's noise within the tolerance at " << t << " s";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace coloc::pipeline

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include <thread>
 
@@ -259,8 +260,9 @@ io::PointCloud2 toMessage(const ndt::PointCloud& cloud, Stamp stamp) {
 }
 
 // The real HDL-32E pair's source scan `count` times, 0.1 s apart, as a standing vehicle would see it;
-// the message at `truncated` (if any) cut to a third.
-void writeScanLog(const std::string& path, int count, int truncated = -1) {
+// the message at `truncated` (if any) cut to a third; with `twist_speed` >= 0, twists at 50 Hz that
+// read that speed (m/s, variance 0.0025).
+void writeScanLog(const std::string& path, int count, int truncated = -1, double twist_speed = -1.0) {
   const ndt::PointCloud scan = ndt::loadPcd(testing::realData("hdl32e_pair/source.pcd"));
   const Stamp t0 = 1'700'000'000'000'000'000LL;
   io::BagWriter bag = io::BagWriter::create(path);
@@ -269,6 +271,18 @@ void writeScanLog(const std::string& path, int count, int truncated = -1) {
     io::Bytes b = io::encodePointCloud2(toMessage(scan, t0 + i * 100'000'000LL));
     if (i == truncated) b.resize(b.size() / 3);
     bag.write("/points", t0 + i * 100'000'000LL + 30'000'000LL, b.data(), b.size());
+  }
+  if (twist_speed >= 0.0) {
+    bag.addTopic(topicOf("/vehicle/twist", "geometry_msgs/msg/TwistWithCovarianceStamped"));
+    for (int k = 0; k < 5 * count; ++k) {
+      io::StampedTwist tw;
+      tw.header = {t0 + k * 20'000'000LL, "base_link"};
+      tw.measurement.linear = {twist_speed, 0.0, 0.0};
+      tw.measurement.covariance = Matrix6d::Zero();
+      tw.measurement.covariance.diagonal() << 0.0025, 0.0, 0.0, 0.0, 0.0, 2.5e-5;
+      const io::Bytes b = io::encodeTwistWithCovarianceStamped(tw);
+      bag.write("/vehicle/twist", t0 + k * 20'000'000LL + 1'000'000LL, b.data(), b.size());
+    }
   }
   bag.close();
 }
@@ -338,14 +352,19 @@ ReplayResult replayAgainstThePairsMap(const std::string& log, const std::string&
   return replayLog(log, options);
 }
 
+// Where the pair's source scan lies on its target map (the pair's ground truth), x and y.
+Eigen::Vector2d wherePairsScansMatch() {
+  const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
+  return {gt1(0, 3), gt1(1, 3)};
+}
+
 // NDT's error by place (ndt.quality_map): where a drive with a reference found NDT poor, its poses are
 // worth no more than that, whatever their fit says; elsewhere they are as NDT gives them. A map that
 // cannot be read stops the replay before anything is fused, naming the file.
 TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
   testing::TempDir dir;
   writeScanLog(dir / "scans", 3);
-  const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
-  const Eigen::Vector2d here(gt1(0, 3), gt1(1, 3));
+  const Eigen::Vector2d here = wherePairsScansMatch();
   // One cell (10 m) around where the scans are matched, NDT 0.5 m off there on the reference drive;
   // another far away.
   std::vector<pipeline::NdtQualitySample> samples;
@@ -414,6 +433,98 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
     FAIL() << "a quality map that is not there was taken";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("absent.yaml"), std::string::npos) << e.what();
+  }
+}
+
+// ndt.quality_floor: noise. Where nothing tells NDT's bias apart it is followed, and each pose is
+// worth its own part alone: at least its place's scan-to-scan noise in every direction and in yaw,
+// and at most what NDT was there on the reference drive (its score's probes, half a metre apart,
+// cannot tell a millimetre from a centimetre).
+TEST(LogReplay, NdtAtItsNoiseTakesEachPoseBetweenItsPlacesNoiseAndItsErrorInEachDirection) {
+  testing::TempDir dir;
+  writeScanLog(dir / "scans", 3);
+  const Eigen::Vector2d here = wherePairsScansMatch();
+  // The reference drive, eastward through the cell: NDT 5 cm ahead with 1 cm of noise along, 1 mm to
+  // the left with 0.5 mm across, its yaw 1 mrad off with 1 mrad of noise.
+  std::vector<pipeline::NdtQualitySample> samples;
+  for (int i = 0; i < 10; ++i) {
+    const double sign = i % 2 ? 1.0 : -1.0;
+    samples.push_back({here + Eigen::Vector2d(0.3 * i - 1.5, 0.0), Eigen::Vector2d(0.05 + 0.005 * sign, 0.001 + 0.00025 * sign), 0.0, 0.001 + 0.0005 * sign});
+  }
+  const pipeline::NdtQualityMap map = pipeline::NdtQualityMap::fromErrors(samples, 10.0, 5, 0.0);
+  std::ofstream(dir / "noise.yaml") << map.toYaml();
+  const auto replay = [&](const std::string& floor) {
+    ReplayOptions options;
+    options.map = testing::realData("hdl32e_pair/target.pcd");
+    options.keep_filter_inputs = true;
+    options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\n  travel_check_window: 0\nndt:\n  voxel_size: 1.0\n"
+                                           "  covariance_floor: [1e-9, 1e-9, 0.0225, 0.000625, 0.000625, 1e-9]\n  quality_map: " + (dir / "noise.yaml") +
+                                               "\n  quality_floor: " + floor + "\n",
+                                           "test.yaml");
+    return replayLog(dir / "scans", options);
+  };
+  const ReplayResult error = replay("error"), noise = replay("noise");
+  ASSERT_EQ(noise.ndt.poses, 3u);
+  EXPECT_EQ(error.pipeline_report.ndt_quality_lowered, 0u);
+  int seen = 0;
+  for (const auto& [name, pose] : noise.weighed_poses) {
+    if (name != pipeline::kNdtSource) continue;
+    ++seen;
+    const double yaw = std::atan2(pose.pose.orientation.toRotationMatrix()(1, 0), pose.pose.orientation.toRotationMatrix()(0, 0));
+    const Eigen::Matrix2d floor = *map.noiseAt(pose.pose.position.head<2>(), yaw), cap = *map.errorAt(pose.pose.position.head<2>(), yaw);
+    const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(xy - floor).eigenvalues().minCoeff(), -1e-15) << "at least the noise";
+    // In the vehicle's frame: across, at most the place's error (1e-6 + 6e-8 m^2), where NDT's fit
+    // claimed more; along, the fit's own where it lies between the two.
+    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(-yaw).toRotationMatrix();
+    const Eigen::Matrix2d body = turn * xy * turn.transpose(), body_cap = turn * cap * turn.transpose();
+    EXPECT_LE(body(1, 1), body_cap(1, 1) * (1.0 + 1e-6));
+    EXPECT_LE(body(0, 0), body_cap(0, 0) * (1.0 + 1e-6));
+    EXPECT_NEAR(pose.covariance(5, 5), *map.yawNoiseAt(pose.pose.position.head<2>()), 1e-12) << "NDT's yaw, its floor 1e-9, raised to the place's noise";
+  }
+  EXPECT_EQ(seen, 3);
+  EXPECT_GE(noise.pipeline_report.ndt_quality_lowered, 1u) << "where NDT's fit claimed more across than NDT was there";
+  // On their own (for the smoother, NDT's topic) the poses stay at their place's whole error, and
+  // so does the filter's in the default mode.
+  for (const auto& [name, pose] : noise.filter_poses) {
+    if (name != pipeline::kNdtSource) continue;
+    const double trace = pose.covariance.topLeftCorner<2, 2>().trace();
+    EXPECT_GE(trace, 2.0 * map.varianceAt(here) * (1.0 - 1e-9));
+  }
+  for (const auto& [name, pose] : error.weighed_poses) {
+    if (name != pipeline::kNdtSource) continue;
+    const double trace = pose.covariance.topLeftCorner<2, 2>().trace();
+    EXPECT_GE(trace, 2.0 * map.varianceAt(here) * (1.0 - 1e-9)) << "at its place's whole error";
+  }
+  // A key that is neither is refused naming it.
+  try {
+    pipeline::parseConfig("ndt:\n  quality_floor: bias\n", "test.yaml");
+    FAIL() << "quality_floor: bias taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("quality_floor"), std::string::npos) << e.what();
+  }
+}
+
+// pipeline.speed_scale_uncertainty: the odometry's stated covariance says nothing of its wheel's
+// scale, which NDT's chords teach only after the first 5 m; until then each twist's speed variance
+// holds a wheel's 2 % of its speed as well. Off, the twists go in as the log has them.
+TEST(LogReplay, BeforeTheScaleIsLearnedEachTwistsSpeedVarianceHoldsAWheelsTwoPercent) {
+  testing::TempDir dir;
+  writeScanLog(dir / "scans", 3, -1, 2.0);
+  const auto replay = [&](const std::string& on) {
+    ReplayOptions options;
+    options.map = testing::realData("hdl32e_pair/target.pcd");
+    options.keep_filter_inputs = true;
+    options.config = pipeline::parseConfig("pipeline:\n  initial_pose: [0.3, 0.3, 0.0, 0.0]\n  speed_scale_uncertainty: " + on + "\nndt:\n  voxel_size: 1.0\n", "test.yaml");
+    return replayLog(dir / "scans", options);
+  };
+  const ReplayResult with = replay("true"), without = replay("false");
+  ASSERT_EQ(with.filter_twists.size(), 15u);
+  ASSERT_EQ(with.received_twists.size(), 15u);
+  for (std::size_t i = 0; i < with.filter_twists.size(); ++i) {
+    EXPECT_NEAR(with.filter_twists[i].second.covariance(0, 0), 0.0025 + (0.02 * 2.0) * (0.02 * 2.0), 1e-12) << i;
+    EXPECT_NEAR(without.filter_twists[i].second.covariance(0, 0), 0.0025, 1e-15) << i;
+    EXPECT_EQ(with.received_twists[i].second.covariance(0, 0), 0.0025) << "as the log has it";
   }
 }
 

@@ -35,6 +35,25 @@ inline Eigen::Matrix2d coveringAtLeast(const Eigen::Matrix2d& covariance, const 
   return symmetric + mapPrincipalVariances(floor - symmetric, [](double v) { return v > 0.0 ? v : 0.0; });
 }
 
+/// At most `covariance` and at most `ceiling` in every direction: in the space where the ceiling is
+/// round (whitened by it), the covariance's principal variances above 1 taken down to 1. Below the
+/// ceiling it is unchanged; it keeps its shape where it can. A ceiling with no variance in some
+/// direction holds the result to none there.
+inline Eigen::Matrix2d coveredAtMost(const Eigen::Matrix2d& covariance, const Eigen::Matrix2d& ceiling) {
+  const Eigen::Matrix2d symmetric = 0.5 * (covariance + covariance.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> c(0.5 * (ceiling + ceiling.transpose()));
+  if (c.info() != Eigen::Success) return symmetric;
+  const double top = std::max(c.eigenvalues()[1], 0.0);
+  if (!(top > 0.0)) return Eigen::Matrix2d::Zero();
+  // The ceiling's square root and its inverse; a direction it leaves empty kept a billionth of its other.
+  const Eigen::Vector2d root = c.eigenvalues().cwiseMax(1e-18 * top).cwiseSqrt();
+  const Eigen::Matrix2d unwhiten = c.eigenvectors() * root.asDiagonal() * c.eigenvectors().transpose();
+  const Eigen::Matrix2d whiten = c.eigenvectors() * root.cwiseInverse().asDiagonal() * c.eigenvectors().transpose();
+  const Eigen::Matrix2d capped = mapPrincipalVariances(whiten * symmetric * whiten, [](double v) { return std::clamp(v, 0.0, 1.0); });
+  const Eigen::Matrix2d out = unwhiten * capped * unwhiten;
+  return 0.5 * (out + out.transpose());
+}
+
 /// The largest variance in any direction (the larger eigenvalue of the symmetric part), at least 0;
 /// NaN if the covariance has no real eigen-decomposition.
 inline double largestPrincipalVariance(const Eigen::Matrix2d& covariance) {

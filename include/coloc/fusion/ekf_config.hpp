@@ -17,6 +17,12 @@ struct EkfConfig {
   double proc_stddev_yaw_c = 0.005;  ///< rad/s; yaw process noise, Q = (c * dt)^2
   double proc_stddev_vx_c = 10.0;    ///< m/s^2; speed process noise
   double proc_stddev_wz_c = 5.0;     ///< rad/s^2; yaw-rate process noise
+  /// rad/sqrt(s); the yaw bias as a random walk in time (its variance grows by walk^2 per second), with
+  /// enable_yaw_bias_estimation. 0: constant, as Autoware's. NDT's heading is off by a tenth of a
+  /// degree that changes with the place (the map, the scene), and a constant bias then turns the
+  /// direction of motion wherever NDT's yaw is trusted near its scan-to-scan noise (docs/filter.md, *NDT
+  /// at its noise*).
+  double yaw_bias_walk = 0.0;
 
   int pose_smoothing_steps = 5;   ///< ticks over which one pose is applied, each with covariance x steps
   int max_pose_queue_size = 5;    ///< poses of one source being smoothed at once

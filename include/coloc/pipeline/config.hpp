@@ -80,6 +80,13 @@ struct NdtSection {
   /// on the twin it makes NDT's innovations across the road honest but not yet along it
   /// (docs/filter.md, *The odometry's slow errors*).
   bool quality_noise_by_direction = false;
+  /// What the quality map makes of an NDT pose where nothing tells NDT's bias apart: "error", at least
+  /// its place's whole mean square error (the bias counted with every scan), or "noise", at least its
+  /// place's scan-to-scan noise along the vehicle, across it and in yaw and at most its place's error
+  /// along and across (the bias followed as NDT follows it, and counted nowhere; NDT's score claims
+  /// decimetres where the scene holds it only loosely). "noise" does the same where the bias is loose.
+  /// "error" by default: the experiment's figures were measured so (docs/filter.md, *NDT at its noise*).
+  std::string quality_floor = "error";
 };
 
 /// Roadside fixes: which RSUs are trusted and how fresh a fix must be.
@@ -131,6 +138,10 @@ struct PipelineSection {
   /// NDT noise (1.25 % at worst in eight drives, test SpeedScale.*), is better than none against the
   /// 0.5-2 % of real tyres (every site and speed of the experiment: the fused error equal or lower).
   double speed_scale_min_distance = 5.0;  ///< m
+  /// Each twist's speed variance also holds the learned scale's doubt, (scaleSd vx)^2: 2 % before the
+  /// scale is usable (the first chord), the chords' figure after. Off: the twist's covariance as given,
+  /// which says nothing of the wheel's scale (docs/filter.md, *NDT at its noise*).
+  bool speed_scale_uncertainty = false;
   /// Learn the odometry's yaw-rate bias (gyro) from NDT's heading changes and remove it before the
   /// filter. Off by default: it finds the twin's 0.002 rad/s within 0.0003, but with Autoware's loose
   /// yaw-rate covariance the filter gains nothing, and on site B's bend the corrected heading tipped
@@ -151,6 +162,11 @@ struct PipelineSection {
   double travel_check_window = 0.5;                ///< s; 0 = off
   double travel_check_tolerance = 0.03;            ///< m
   double travel_check_tolerance_per_metre = 0.005; ///< m per m of travel
+  /// rad: each chord's turn too, NDT's heading change against the yaw rate's; the disagreement beyond
+  /// this (and 0.002 rad/s of the chord's time) added to the pose's yaw variance. 0 = off: with NDT's
+  /// yaw at Autoware's 1.4 deg a mismatched scan's turn hides in it, not where NDT's yaw is taken at
+  /// its noise (ndt.quality_floor: noise).
+  double travel_check_turn_tolerance = 0.0;
   /// A pose with no chord to compare yet (the first window after a start) is taken at no better than
   /// this standard deviation in x and y (Autoware's fixed NDT covariance by default).
   double travel_check_unverified_sd = 0.15;        ///< m

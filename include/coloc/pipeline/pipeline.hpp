@@ -89,12 +89,18 @@ struct PipelineReport {
   std::uint64_t ndt_travel_disagreements = 0;
   double ndt_travel_max_excess = 0.0;
   std::uint64_t ndt_travel_unverified = 0;   ///< with no chord to compare yet, taken at travel_check_unverified_sd
+  /// NDT poses whose turn disagreed with the yaw rate's beyond pipeline.travel_check_turn_tolerance
+  /// (their yaw variance widened by the excess), and the largest excess, rad.
+  std::uint64_t ndt_turn_disagreements = 0;
+  double ndt_turn_max_excess = 0.0;
   /// NDT poses the roadside's fixes disagreed with beyond pipeline.fix_agreement_tolerance (their
   /// covariance widened by the excess), and the largest excess, m.
   std::uint64_t ndt_fix_disagreements = 0;
   double ndt_fix_max_excess = 0.0;
   /// NDT poses whose x/y variance ndt.quality_map raised to their place's figure.
   std::uint64_t ndt_quality_raised = 0;
+  /// NDT poses whose covariance was taken down to their place's error by direction (ndt.quality_floor: noise).
+  std::uint64_t ndt_quality_lowered = 0;
   std::uint64_t rejections = 0;              ///< every refusal, of any kind
   std::vector<std::string> first_rejections; ///< the first few, as one line each
 };
@@ -145,6 +151,9 @@ class Pipeline {
   /// smoother and NDT's own topic: each with the covariance it has on its own (where the filter models
   /// NDT's bias, NDT's pose at its place's whole error, not the noise the filter takes it at).
   void onPoseInput(std::function<void(const std::string& source, const PoseMeasurement&)> callback);
+  /// The same poses as the filter weighs them: NDT's at what ndt.quality_map and the checks made of
+  /// it for the filter (its noise where the bias is loose or followed), the others as onPoseInput's.
+  void onPoseWeighed(std::function<void(const std::string& source, const PoseMeasurement&)> callback);
   /// For every pose the filter took, once its smoothing is over: the filter's estimate for the pose's
   /// stamp from everything stamped up to it (the same information the source's own pose has), for
   /// comparing the filter with each of its inputs.

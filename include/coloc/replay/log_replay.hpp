@@ -77,6 +77,9 @@ struct ReplayResult {
   /// With ReplayOptions::keep_filter_inputs: every pose and twist as the filter got them (after NDT,
   /// the fix checks and the speed scale), and the filter's state at every tick, for a smoother.
   std::vector<std::pair<std::string, PoseMeasurement>> filter_poses;
+  /// The same poses as the filter weighed them (Pipeline::onPoseWeighed): NDT's at its noise where the
+  /// filter models or follows its bias, where filter_poses has them on their own.
+  std::vector<std::pair<std::string, PoseMeasurement>> weighed_poses;
   std::vector<std::pair<std::string, TwistMeasurement>> filter_twists;
   std::vector<std::pair<std::string, TwistMeasurement>> received_twists;  ///< the same twists as the log has them
   std::vector<std::pair<Stamp, Vector6d>> fused_states;
