@@ -556,6 +556,13 @@ void Localizer::setMapMatchBiasVariance(double variance) {
   if (impl_->config.map_match_bias_sd > 0.0) impl_->history.setBiasVariance(variance);
 }
 
+void Localizer::releaseMapMatchBias(Stamp stamp, double variance) {
+  if (!(std::isfinite(variance) && variance >= 0.0 && variance <= 1e6))
+    throw Error("map-matching bias release: must be finite and in [0, 1e6] m^2, got " + std::to_string(variance));
+  if (!(impl_->config.map_match_bias_sd > 0.0 && impl_->initialized)) return;
+  impl_->history.releaseBias(impl_->history.ticksBack(stamp).value_or(0), variance * Eigen::Matrix2d::Identity());
+}
+
 const IntegrityStatus& Localizer::integrity() const { return impl_->integrity.status(); }
 
 void Localizer::doubt(const std::string& reason, const Eigen::Vector2d& offset) {

@@ -22,6 +22,7 @@ void StateHistory::reset(Stamp stamp, const FilterState& initial) {
   Slot& s = slots_[0];
   s.prior = s.posterior = initial;
   s.updates.clear();
+  s.release.setZero();
 }
 
 std::optional<int> StateHistory::ticksBack(Stamp stamp) const {
@@ -58,6 +59,23 @@ void StateHistory::predictInto(const FilterState& from, Slot& into, bool first_t
   predictAux(prior, options_.aux_proc_dev, dt_);
 }
 
+void StateHistory::applyRelease(FilterState& prior, const Eigen::Matrix2d& spread) {
+  if (!prior.extra.bias_modelled || spread.isZero(0.0)) return;
+  prior.P.topLeftCorner<2, 2>() += spread;
+  prior.extra.P.topLeftCorner<2, 2>() += spread;
+  prior.extra.cross.topLeftCorner<2, 2>() -= spread;  // rows x, y; columns the bias's x, y
+}
+
+void StateHistory::releaseBias(int ticks_back, const Eigen::Matrix2d& spread) {
+  if (ticks_back < 0 || ticks_back >= count_) throw std::out_of_range("bias release outside the state history");
+  refresh(ticks_back);
+  Slot& s = slot(ticks_back);
+  s.release += spread;
+  applyRelease(s.prior, spread);
+  applyAll(s);
+  if (ticks_back > 0 && ticks_back - 1 > dirty_) dirty_ = ticks_back - 1;
+}
+
 void StateHistory::applyAll(Slot& s) {
   s.posterior = s.prior;
   for (const UpdateRecord& r : s.updates) applyUpdate(s.posterior, r);
@@ -68,6 +86,7 @@ void StateHistory::refresh(int down_to) {
   for (; dirty_ >= down_to; --dirty_) {
     Slot& s = slot(dirty_);
     predictInto(slot(dirty_ + 1).posterior, s, false);
+    applyRelease(s.prior, s.release);
     applyAll(s);
   }
 }
@@ -78,6 +97,7 @@ void StateHistory::advance() {
   const std::size_t next = (head_ + 1) % slots_.size();
   Slot& s = slots_[next];
   s.updates.clear();
+  s.release.setZero();
   predictInto(slots_[head_].posterior, s, true);
   s.posterior = s.prior;
   head_ = next;

@@ -65,11 +65,19 @@ class StateHistory {
   void setBiasVariance(double variance) { options_.extra.bias_variance = variance; }
   double biasVariance() const { return options_.extra.bias_variance; }
 
+  /// The map-matching bias let in at a tick (ticks back) with its spread (m^2 per axis, 2x2): the
+  /// position followed NDT's bias while nothing told it apart, so it is uncertain by that spread and
+  /// the bias is its difference from the truth (position and bias covariance -spread). Kept with the
+  /// tick, so the ticks filtered again after a late measurement take it too. Nothing where the bias is
+  /// not modelled.
+  void releaseBias(int ticks_back, const Eigen::Matrix2d& spread);
+
  private:
   struct Slot {
     FilterState prior;      ///< predicted from the previous tick (the base for the oldest slot)
     FilterState posterior;  ///< prior with `updates` applied in order
     std::vector<UpdateRecord> updates;
+    Eigen::Matrix2d release = Eigen::Matrix2d::Zero();  ///< the bias let in at this tick (releaseBias)
     // The linearisation of the step into this slot, fixed when it was first predicted.
     Vector6d from_linearization = Vector6d::Zero();
     Vector6d predicted_from_linearization = Vector6d::Zero();
@@ -80,6 +88,7 @@ class StateHistory {
   void predictInto(const FilterState& from, Slot& into, bool first_time) const;
   void refresh(int down_to);
   static void applyAll(Slot& s);
+  static void applyRelease(FilterState& prior, const Eigen::Matrix2d& spread);
 
   HistoryOptions options_;
   double dt_;

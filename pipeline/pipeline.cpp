@@ -194,6 +194,7 @@ struct Pipeline::Impl {
   bool first_input_seen = false;
   Stamp clock = 0;
   std::optional<Stamp> last_anchor;  ///< stamp of the newest roadside fix the filter took
+  std::optional<Stamp> last_release;  ///< of the newest fix NDT's followed bias was let in before
   /// Counts the clock's jumps back: NDT's results from scans submitted before one are dropped.
   std::uint64_t timeline = 0;
   bool clock_set = false;
@@ -498,6 +499,41 @@ struct Pipeline::Impl {
     }
   }
 
+  // NDT's bias's spread at `at` for a vehicle heading `heading`: its place's whole error less its
+  // scan-to-scan noise (the filter's own figure where the map has none).
+  double biasSpreadAt(const Eigen::Vector2d& at, double heading) const {
+    const double place = ndt_quality.varianceAt(at);
+    if (!(place > 0.0)) return config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
+    const bool by_direction = config.ndt.quality_floor == "noise" || config.ndt.quality_noise_by_direction;
+    if (const std::optional<Eigen::Matrix2d> noise = by_direction ? ndt_quality.noiseAt(at, heading) : std::nullopt)
+      return std::max(place - 0.5 * noise->trace(), 0.0);
+    return std::max(place - ndt_quality.noiseVariance(), 0.0);
+  }
+
+  // Whether the bias is told apart at `stamp`: a roadside fix within its length of travel, or the
+  // odometry's slow errors modelled as states (handle() says why).
+  bool biasToldApart(Stamp stamp, const std::optional<fusion::Estimate>& now) const {
+    const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
+    return config.fusion.modelsOdometryErrors() || (last_anchor && stamp - *last_anchor <= fromSeconds(hold));
+  }
+
+  // Before a roadside fix that tells NDT's bias apart where NDT's poses followed it (ndt.quality_floor:
+  // noise): the position carries the bias, by its place's spread. Held at nothing until the fix, the
+  // filter could not move by it: on the twin's site E, entering coverage 9 cm off across the road
+  // behind NDT, the first fixes moved it by nothing for 0.8 s.
+  void releaseFollowedBias(Stamp stamp) {
+    if (!(config.fusion.map_match_bias_sd > 0.0 && config.ndt.quality_floor == "noise" && localizer.initialized())) return;
+    const std::optional<fusion::Estimate> now = localizer.estimate();
+    if (!now || biasToldApart(stamp, now)) return;
+    // Once for a stretch of fixes the filter refuses: each would let it in again.
+    const double hold = config.fusion.map_match_bias_length / std::max(std::abs(now->linear_velocity.x()), 1.0);
+    if (last_release && stamp >= *last_release && stamp - *last_release <= fromSeconds(hold)) return;
+    last_release = stamp;
+    const double spread = biasSpreadAt(now->pose.position.head<2>(), rollPitchYaw(now->pose.orientation)[2]);
+    localizer.setMapMatchBiasVariance(spread);
+    localizer.releaseMapMatchBias(stamp, spread);
+  }
+
   void handle(const ndt::ScanOutcome& outcome, Stamp scan_stamp) {
     if (!outcome.produced) return reject("scan stamped " + formatSeconds(scan_stamp) + ": " + outcome.detail);
     // The LiDAR's mounting yaw as learned so far: the LiDAR is where NDT put it, the car is turned
@@ -568,8 +604,7 @@ struct Pipeline::Impl {
     }
     const std::optional<fusion::Estimate> now = localizer.estimate();
     if (config.fusion.map_match_bias_sd > 0.0) {
-      const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
-      const bool told_apart = config.fusion.modelsOdometryErrors() || (last_anchor && pose.stamp - *last_anchor <= fromSeconds(hold));
+      const bool told_apart = biasToldApart(pose.stamp, now);
       double spread = 0.0;
       if (told_apart) {
         spread = config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
@@ -725,6 +760,7 @@ struct Pipeline::Impl {
       fix_agreement.addFix(v.measurement.stamp, v.measurement.pose.position.head<2>(), 0.5 * v.measurement.covariance.topLeftCorner<2, 2>().trace());
       initializer.addPosition(source_names[source], v.measurement.stamp, v.measurement.pose.position.head<2>(), v.measurement.covariance(0, 0));
       if (!localizer.initialized()) tryStart();
+      releaseFollowedBias(v.measurement.stamp);
       const fusion::Verdict taken = feedPose(source, v.measurement);
       if (!taken.rejected()) last_anchor = std::max(last_anchor.value_or(v.measurement.stamp), v.measurement.stamp);
       if (taken.applied()) check_start = false;  // the roadside agrees: the start is confirmed

@@ -136,6 +136,48 @@ TEST(MapMatchBias, ALateFixGivesTheSameBiasAndPoseAsOnTime) {
   EXPECT_GT(a.map_match_bias.x(), 0.03);  // the one fix moved the bias towards NDT's 10 cm
 }
 
+// Where NDT's poses followed the bias (held at nothing, NDT at its 1 cm noise, 10 cm off), the
+// position carries it: let in with its spread at the first fix's tick, that fix moves the position
+// most of the way to the truth, where without it the filter, sure of its position, barely moves; a
+// late fix after a release gives what an on-time one gives; bad spreads are refused.
+TEST(MapMatchBias, ABiasLetInAtAFixLetsTheFixMoveThePositionAndALateFixGivesTheSameAsOnTime) {
+  const auto run = [](bool release, int fix_delay) {
+    Localizer f(withBias());
+    f.addTwistSource("odom");
+    f.addPoseSource("ndt");
+    f.addPoseSource("rsu", 0, true);
+    f.setMapMatchBiasVariance(0.0);
+    EXPECT_TRUE(f.initialize(planarPose(kStart, 0.1, 0.0, 0.0, 1e-4, 1e-6), twist(kStart, kSpeed, 0.0, 0.0025, 1e-5)).applied());
+    for (int k = 1; k <= 60; ++k) {
+      const Stamp t = kStart + k * kTick;
+      const double x = kSpeed * k * toSeconds(kTick);
+      f.advanceTo(t);
+      f.feedTwist("odom", twist(t, kSpeed, 0.0, 0.0025, 1e-5));
+      if (k % 5 == 0) f.feedPose("ndt", planarPose(t, x + 0.1, 0.0, 0.0, 1e-4, 1e-6));
+      if (k == 40 + fix_delay) {
+        const Stamp at = kStart + 40 * kTick;
+        if (release) {
+          f.setMapMatchBiasVariance(0.01);
+          f.releaseMapMatchBias(at, 0.01);
+        }
+        EXPECT_TRUE(f.feedPose("rsu", fix2d(at, kSpeed * 40 * toSeconds(kTick), 0.0, 2e-4)).applied());
+      }
+    }
+    return *f.estimate();
+  };
+  const Estimate released = run(true, 0), held = run(false, 0), late = run(true, 4);
+  const double truth = kSpeed * 60 * toSeconds(kTick);
+  EXPECT_LT(std::abs(released.pose.position.x() - truth), 0.03) << "the fix took most of NDT's 10 cm back";
+  EXPECT_GT(std::abs(held.pose.position.x() - truth), 0.08) << "sure of its position, the filter barely moved";
+  EXPECT_GT(released.map_match_bias.x(), 0.07);
+  EXPECT_NEAR((released.pose.position - late.pose.position).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((released.map_match_bias - late.map_match_bias).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((released.map_match_bias_covariance - late.map_match_bias_covariance).norm(), 0.0, 1e-12);
+  Localizer f(withBias());
+  for (double bad : {-1.0, std::nan(""), kInfinity}) EXPECT_THROW(f.releaseMapMatchBias(kStart, bad), Error);
+  EXPECT_NO_THROW(f.releaseMapMatchBias(kStart, 0.01)) << "before the start: nothing to let it into";
+}
+
 TEST(MapMatchBias, AVarianceThatIsNotOneIsRefusedNamingIt) {
   Localizer filter(withBias());
   for (double bad : {-1.0, std::nan(""), kInfinity, 2e6}) EXPECT_THROW(filter.setMapMatchBiasVariance(bad), Error);

@@ -102,6 +102,11 @@ class Localizer {
   /// towards from now on (the place's, from an NDT quality map); ignored where it is not modelled.
   /// Throws coloc::Error for a variance that is negative, NaN, infinite or above 1e6.
   void setMapMatchBiasVariance(double variance);
+  /// The bias let in at `stamp`'s tick (the newest where it is older than the history), with its
+  /// spread per axis (m^2): where the bias was held and NDT's poses followed it (ndt.quality_floor:
+  /// noise), the position carries it, and the roadside fix that now tells it apart must be able to
+  /// move the position by it. Nothing without the bias state or before the filter started.
+  void releaseMapMatchBias(Stamp stamp, double variance);
 
   Verdict feedPose(SourceId source, const PoseMeasurement& measurement);
   Verdict feedPose(std::string_view source, const PoseMeasurement& measurement);
