@@ -335,7 +335,7 @@ const std::vector<Key>& keys() {
       {"pipeline", "fix_agreement_tolerance", "m", "the disagreement between NDT and the fixes that their noise and the RSU's survey explain",
        [](const C& c) { return show(c.pipeline.fix_agreement_tolerance); },
        [](const R& r, const N& n, const S& k, C& c) { c.pipeline.fix_agreement_tolerance = r.inRange(n, k, 0.0, 10.0); }},
-      {"pipeline", "travel_check_turn_tolerance", "rad", "each chord's turn held against the yaw rate's: the disagreement beyond this (and 0.002 rad/s of the chord) is added to the pose's yaw variance; 0 = off",
+      {"pipeline", "travel_check_turn_tolerance", "rad", "each chord's turn held against the yaw rate's: a disagreement beyond this (and 0.002 rad/s of the chord) is added, whole, to the pose's yaw variance; 0 = off",
        [](const C& c) { return show(c.pipeline.travel_check_turn_tolerance); },
        [](const R& r, const N& n, const S& k, C& c) { c.pipeline.travel_check_turn_tolerance = r.inRange(n, k, 0.0, 1.0); }},
       {"pipeline", "travel_check_tolerance", "m", "the disagreement that NDT's and the odometry's noise explain over one chord",

@@ -607,12 +607,9 @@ struct Pipeline::Impl {
       const bool told_apart = biasToldApart(pose.stamp, now);
       double spread = 0.0;
       if (told_apart) {
-        spread = config.fusion.map_match_bias_sd * config.fusion.map_match_bias_sd;
-        if (place > 0.0) floor = ndt_quality.noiseVariance(), spread = std::max(place - floor, 0.0);
-        if (noise && (at_noise || floorAtNoise())) {
-          spread = std::max(place - 0.5 * noise->trace(), 0.0);
-          floor = 0.0;
-        }
+        spread = biasSpreadAt(at, rollPitchYaw(pose.pose.orientation)[2]);
+        if (place > 0.0) floor = ndt_quality.noiseVariance();
+        if (noise && (at_noise || floorAtNoise())) floor = 0.0;
       }
       localizer.setMapMatchBiasVariance(spread);
     }
@@ -642,10 +639,10 @@ struct Pipeline::Impl {
       ++report.ndt_travel_disagreements;
       report.ndt_travel_max_excess = std::max(report.ndt_travel_max_excess, excess->norm());
     }
-    if (const double turn = travel_check.turnExcess(); turn > 0.0) {
+    if (const double turn = travel_check.turnDisagreement(); turn > 0.0) {
       for (PoseMeasurement* p : {&pose, &alone}) p->covariance(5, 5) += turn * turn;
       ++report.ndt_turn_disagreements;
-      report.ndt_turn_max_excess = std::max(report.ndt_turn_max_excess, turn);
+      report.ndt_turn_max_disagreement = std::max(report.ndt_turn_max_disagreement, turn);
     }
     // Where the roadside's fixes disagree with NDT's position, its pose is worth no more than that.
     if (const std::optional<Eigen::Vector2d> off = fix_agreement.check(pose.stamp, pose.pose.position.head<2>(), yaw, place); off && off->squaredNorm() > 0.0) {

@@ -93,7 +93,7 @@ std::string learnedJson(const PipelineReport& r) {
   nlohmann::ordered_json j;
   j["ndt_travel_check"] = {{"disagreements", r.ndt_travel_disagreements}, {"max_excess_m", r.ndt_travel_max_excess},
                            {"unverified", r.ndt_travel_unverified}, {"turn_disagreements", r.ndt_turn_disagreements},
-                           {"turn_max_excess_rad", r.ndt_turn_max_excess}};
+                           {"turn_max_disagreement_rad", r.ndt_turn_max_disagreement}};
   j["ndt_fix_agreement"] = {{"disagreements", r.ndt_fix_disagreements}, {"max_excess_m", r.ndt_fix_max_excess}};
   j["ndt_quality_map"] = {{"raised", r.ndt_quality_raised}, {"lowered", r.ndt_quality_lowered}};
   j["odometry_speed_scale"] = {{"scale", r.speed_scale}, {"compared_m", r.speed_scale_distance}};

@@ -76,7 +76,7 @@ void TravelCheck::reset() {
 }
 
 std::optional<Eigen::Vector2d> TravelCheck::check(Stamp stamp, const Eigen::Vector2d& position, double yaw) {
-  turn_excess_ = 0.0;
+  turn_disagreement_ = 0.0;
   if (config_.window <= 0.0) return Eigen::Vector2d::Zero().eval();
   if (!position.allFinite() || !std::isfinite(yaw)) return std::nullopt;
   // Poses out of order (a late scan) are neither compared nor kept: chords run forward in time.
@@ -121,7 +121,7 @@ std::optional<Eigen::Vector2d> TravelCheck::check(Stamp stamp, const Eigen::Vect
     // Beyond the tolerance the whole turn is NDT's: a heading that steps where the map or the scene
     // does (site C's corner: 4-6 mrad for four scans) is off by all of it, and widened by the excess
     // alone its poses still stood 8-12 standard deviations off the filter's yaw.
-    if (std::abs(turn) > config_.turn_tolerance + config_.turn_tolerance_per_second * median(spans)) turn_excess_ = std::abs(turn);
+    if (std::abs(turn) > config_.turn_tolerance + config_.turn_tolerance_per_second * median(spans)) turn_disagreement_ = std::abs(turn);
   }
   const double tolerance = config_.tolerance + config_.tolerance_per_metre * median(travels);
   const double norm = difference.norm();

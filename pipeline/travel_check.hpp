@@ -29,8 +29,8 @@ struct TravelCheckConfig {
   /// s: the longest window the check widens to for a slow pose stream (see TravelCheck::window).
   double max_window = 5.0;
   /// rad: NDT's heading change over each chord is held against the yaw rate's turn (where there are
-  /// yaw rates); the part of their median disagreement beyond this, and turn_tolerance_per_second of
-  /// the chord's time, is turnExcess. 0 = the turn not checked.
+  /// yaw rates); their median disagreement, where it is beyond this and turn_tolerance_per_second of
+  /// the chord's time, is turnDisagreement. 0 = the turn not checked.
   double turn_tolerance = 0.0;
   double turn_tolerance_per_second = 0.002;  ///< rad/s: a gyro's bias not yet learned
 };
@@ -48,11 +48,11 @@ class TravelCheck {
   /// it, or when the check is off); nullopt when there is not enough to compare with yet (fewer than
   /// two poses one to two windows old, no odometry) or the pose is not finite. The pose is kept as later chords' start.
   std::optional<Eigen::Vector2d> check(Stamp stamp, const Eigen::Vector2d& position, double yaw);
-  /// The last check's turn: how far NDT's heading change was off the yaw rate's beyond the tolerance
-  /// (rad, >= 0; 0 when within it, unchecked, or with nothing to compare). A scan matched decimetres
-  /// off is turned too (site C's twin drive: 31 cm and 12 mrad at once, where NDT's yaw noise is 0.3
-  /// mrad), and the travel alone widens its x and y only.
-  double turnExcess() const { return turn_excess_; }
+  /// The last check's turn: how far NDT's heading change was off the yaw rate's, where beyond the
+  /// tolerance (rad, >= 0; 0 when within it, unchecked, or with nothing to compare). A scan matched
+  /// decimetres off is turned too (site C's twin drive: 31 cm and 12 mrad at once, where NDT's yaw
+  /// noise is 0.3 mrad), and the travel alone widens its x and y only.
+  double turnDisagreement() const { return turn_disagreement_; }
   void reset();
   /// The window in use: the configured one, or two of the poses' median interval if that is longer
   /// (at most max_window). Chords start at poses one to two windows old, and a LiDAR slower than
@@ -74,7 +74,7 @@ class TravelCheck {
   OdometryIntegral heading_;  ///< the yaw rate's integral
   std::deque<Kept> poses_;
   std::deque<Duration> intervals_;  ///< between the last poses taken, newest last
-  double turn_excess_ = 0.0;
+  double turn_disagreement_ = 0.0;
 };
 
 }  // namespace coloc::pipeline

@@ -54,8 +54,8 @@ std::string learnedLines(const pipeline::PipelineReport& r) {
             "%llu had none to compare yet\n",
        (unsigned long long)r.ndt_travel_disagreements, r.ndt_travel_max_excess, (unsigned long long)r.ndt_travel_unverified);
   if (r.ndt_turn_disagreements > 0)
-    line(out, "  NDT's turn against the yaw rate's: %llu poses disagreed beyond the tolerance (yaw variance widened; largest by %.4f rad)\n",
-         (unsigned long long)r.ndt_turn_disagreements, r.ndt_turn_max_excess);
+    line(out, "  NDT's turn against the yaw rate's: %llu poses disagreed beyond the tolerance (yaw variance widened by it; largest %.4f rad)\n",
+         (unsigned long long)r.ndt_turn_disagreements, r.ndt_turn_max_disagreement);
   if (r.ndt_fix_disagreements > 0)
     line(out, "  NDT's position against the roadside's fixes: %llu poses disagreed beyond the tolerance (covariance widened; largest by %.3f m)\n",
          (unsigned long long)r.ndt_fix_disagreements, r.ndt_fix_max_excess);

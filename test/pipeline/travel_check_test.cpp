@@ -225,7 +225,7 @@ TEST(TravelCheck, AHeadingThatStepsAgainstTheGyrosTurnIsWidenedByTheWholeTurn) {
         const double yaw = rate * t + yaw_noise(rng) + (t >= 2.0 && t < 2.45 ? 0.006 : 0.0);  // NDT's heading 6 mrad off for 0.4 s
         const Eigen::Vector2d p = (10.0 / rate) * Eigen::Vector2d(std::sin(rate * t), 1.0 - std::cos(rate * t));
         check.check(at(t), p, yaw);
-        turns.push_back(check.turnExcess());
+        turns.push_back(check.turnDisagreement());
       }
     }
   };

@@ -162,8 +162,8 @@ struct PipelineSection {
   double travel_check_window = 0.5;                ///< s; 0 = off
   double travel_check_tolerance = 0.03;            ///< m
   double travel_check_tolerance_per_metre = 0.005; ///< m per m of travel
-  /// rad: each chord's turn too, NDT's heading change against the yaw rate's; the disagreement beyond
-  /// this (and 0.002 rad/s of the chord's time) added to the pose's yaw variance. 0 = off: with NDT's
+  /// rad: each chord's turn too, NDT's heading change against the yaw rate's; a disagreement beyond
+  /// this (and 0.002 rad/s of the chord's time) added, whole, to the pose's yaw variance. 0 = off: with NDT's
   /// yaw at Autoware's 1.4 deg a mismatched scan's turn hides in it, not where NDT's yaw is taken at
   /// its noise (ndt.quality_floor: noise).
   double travel_check_turn_tolerance = 0.0;

@@ -74,11 +74,12 @@ class NdtQualityMap {
   /// That noise as an x/y covariance for a vehicle heading `heading` (rad, map frame); nullopt where
   /// not measured.
   std::optional<Eigen::Matrix2d> noiseAt(double heading) const;
-  /// The same at `xy`: its cell's own noise along and across, drawn towards its median cell's by
-  /// kNoisePriorPairs (the map's own figure is the mean, which a few bad cells decide). NDT's noise changes with the place as much as its error does: along the vehicle
-  /// on the twin's noise calibration drives, the 10 m cells' figures span 40x on site A (7e-6 to 3e-4
-  /// m^2 from the tenth to the ninetieth percentile) and 140x on site D, whose cutting alone makes the
-  /// map's figure 50x its median cell's. nullopt where the map has no noise along and across.
+  /// The same at `xy`: its cell's own noise along and across, drawn towards the median cell's by
+  /// kNoisePriorPairs (not towards the map's own figure, a mean that a few bad cells decide). NDT's
+  /// noise changes with the place as much as its error does: along the vehicle on the twin's noise
+  /// calibration drives, the 10 m cells' figures span 40x on site A (7e-6 to 3e-4 m^2 from the tenth
+  /// to the ninetieth percentile) and 140x on site D, whose cutting alone makes the map's figure 50x
+  /// its median cell's. nullopt where the map has no noise along and across.
   std::optional<Eigen::Matrix2d> noiseAt(const Eigen::Vector2d& xy, double heading) const;
   /// NDT's scan-to-scan yaw noise (rad^2), the map's and at `xy` (its cell's, drawn towards the
   /// median cell's as noiseAt); nullopt where not measured (samples without a yaw error, files written before).
@@ -90,7 +91,7 @@ class NdtQualityMap {
   /// site E's open square: 0.03-0.14 m^2 along against innovations of 1e-4), this is the better word.
   std::optional<Eigen::Matrix2d> errorAt(const Eigen::Vector2d& xy, double heading) const;
   std::optional<double> yawNoiseAt(const Eigen::Vector2d& xy) const;
-  /// A cell's noise figures count as this many more consecutive pairs with the map's figures: a 10 m
+  /// A cell's noise figures count as this many more consecutive pairs with the median cell's: a 10 m
   /// cell driven at 10 m/s and 10 Hz holds 9 pairs, whose mean square is off by +-47 % (chi-square, 9
   /// degrees of freedom) and whose inverse, which weighs NDT's poses, runs 29 % high on average.
   static constexpr double kNoisePriorPairs = 5.0;

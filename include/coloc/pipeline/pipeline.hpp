@@ -90,9 +90,9 @@ struct PipelineReport {
   double ndt_travel_max_excess = 0.0;
   std::uint64_t ndt_travel_unverified = 0;   ///< with no chord to compare yet, taken at travel_check_unverified_sd
   /// NDT poses whose turn disagreed with the yaw rate's beyond pipeline.travel_check_turn_tolerance
-  /// (their yaw variance widened by the excess), and the largest excess, rad.
+  /// (their yaw variance widened by the whole disagreement), and the largest such, rad.
   std::uint64_t ndt_turn_disagreements = 0;
-  double ndt_turn_max_excess = 0.0;
+  double ndt_turn_max_disagreement = 0.0;
   /// NDT poses the roadside's fixes disagreed with beyond pipeline.fix_agreement_tolerance (their
   /// covariance widened by the excess), and the largest excess, m.
   std::uint64_t ndt_fix_disagreements = 0;
