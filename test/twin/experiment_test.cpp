@@ -123,6 +123,20 @@ TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideI
   EXPECT_EQ(fuse.fusion.pose_gate_recovery, 0);
 }
 
+TEST(ExperimentConfig, ShippedNdtAtItsNoiseConfigurationLoadsWithItsFuseFileFoundBesideIt) {
+  const ExperimentConfig c = loadExperimentConfig(COLOC_SOURCE_DIR "/config/experiments/ndt_at_its_noise.yaml");
+  EXPECT_TRUE(c.twist_covariance_estimated);
+  EXPECT_EQ(c.ndt_covariance, NdtCovarianceSource::kMultiNdtScore) << "the experiment's own, which hands each replay its quality map";
+  const pipeline::Config fuse = pipeline::loadConfig(c.fuse_config);
+  EXPECT_EQ(fuse.ndt.quality_floor, "noise");
+  EXPECT_DOUBLE_EQ(fuse.fusion.yaw_bias_walk, 0.002);
+  EXPECT_TRUE(fuse.pipeline.speed_scale_uncertainty);
+  EXPECT_DOUBLE_EQ(fuse.pipeline.travel_check_turn_tolerance, 0.002);
+  EXPECT_EQ(fuse.fusion.pose_gate_recovery, 3) << "the experiment's base, which a fuse file replaces whole";
+  EXPECT_DOUBLE_EQ(fuse.pipeline.fix_agreement_window, 0.0);
+  EXPECT_EQ(fuse.ndt.source.ndt.covariance, ndt::CovarianceMode::kFixed);
+}
+
 TEST(ExperimentConfig, BuiltInScenariosAreTheShippedFiles) {
   for (const char* name : {"site_a", "site_b", "site_c", "site_d", "site_e"}) {
     std::ifstream in(std::string(COLOC_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
