@@ -57,9 +57,9 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
   map.gross_left_out_ = static_cast<std::size_t>(std::count(gross.begin(), gross.end(), true));
   struct Sums {
     double square = 0.0;
-    std::size_t poses = 0, pairs = 0, turned = 0;
+    std::size_t poses = 0, pairs = 0, turned = 0, yawed = 0;
     Eigen::Vector2d error = Eigen::Vector2d::Zero(), along_across = Eigen::Vector2d::Zero();
-    double yaw = 0.0;
+    double yaw = 0.0, yaw_error = 0.0;
   };
   std::map<std::pair<long long, long long>, Sums> sums;
   double change = 0.0, all = 0.0, change_yaw = 0.0;  // all: the drive's own sum, for the default
@@ -76,6 +76,11 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
       const Eigen::Vector2d body = Eigen::Rotation2Dd(-s.heading) * s.error;
       sum.error += body.cwiseProduct(body);
       ++sum.turned;
+    }
+    if (std::isfinite(s.yaw_error)) {
+      const double off = std::remainder(s.yaw_error, 2.0 * M_PI);
+      sum.yaw_error += off * off;
+      ++sum.yawed;
     }
     // Two independent draws of the noise differ by twice its variance, per axis; x and y pooled.
     const NdtQualitySample* before = i > 0 && !gross[i - 1] ? &samples[i - 1] : nullptr;
@@ -105,10 +110,11 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
   for (const auto& [index, sum] : sums) {
     if (sum.poses < std::max<std::size_t>(min_samples, 1)) continue;
     Cell c{sum.square / static_cast<double>(sum.poses), sum.poses};
-    if (sum.pairs > 0 && sum.turned > 0) {
+    if (sum.pairs > 0 && sum.turned > 0 && sum.yawed > 0) {
       const double n = static_cast<double>(sum.pairs);
       c.pairs = sum.pairs;
       c.error_along_across = (sum.error / static_cast<double>(sum.turned)).cwiseMin(kMaxVariance);
+      c.error_yaw = std::min(sum.yaw_error / static_cast<double>(sum.yawed), kMaxVariance);
       c.noise_along_across = (sum.along_across / n).cwiseMin(kMaxVariance);
       c.noise_yaw = std::min(sum.yaw / n, kMaxVariance);
     }
@@ -160,6 +166,12 @@ std::optional<Eigen::Matrix2d> NdtQualityMap::errorAt(const Eigen::Vector2d& xy,
   return turn * c->error_along_across.asDiagonal() * turn.transpose();
 }
 
+std::optional<double> NdtQualityMap::yawErrorAt(const Eigen::Vector2d& xy) const {
+  const Cell* c = cellAt(xy);
+  if (!c || c->pairs == 0) return std::nullopt;
+  return c->error_yaw;
+}
+
 std::optional<double> NdtQualityMap::yawNoiseAt(const Eigen::Vector2d& xy) const {
   if (!noise_yaw_) return std::nullopt;
   const Cell* c = cellAt(xy);
@@ -188,11 +200,11 @@ std::string NdtQualityMap::toYaml() const {
   if (gross_left_out_ > 0)
     out << "# " << gross_left_out_ << " pose(s) left out as gross errors (over " << kGrossError << "x their cell's median error): the travel check's to catch, not the place's\n";
   out
-      << "cells:  # [i, j, poses, variance] or, where consecutive poses measured its noise, [..., error_along, error_across, pairs, noise_along, noise_across, noise_yaw]\n";
+      << "cells:  # [i, j, poses, variance] or, where consecutive poses measured its noise, [..., error_along, error_across, error_yaw, pairs, noise_along, noise_across, noise_yaw]\n";
   if (cells_.empty()) out << "  []\n";
   for (const auto& [index, c] : cells_) {
     out << "  - [" << index.first << ", " << index.second << ", " << c.samples << ", " << c.variance;
-    if (c.pairs > 0) out << ", " << c.error_along_across.x() << ", " << c.error_along_across.y() << ", " << c.pairs << ", " << c.noise_along_across.x() << ", " << c.noise_along_across.y() << ", " << c.noise_yaw;
+    if (c.pairs > 0) out << ", " << c.error_along_across.x() << ", " << c.error_along_across.y() << ", " << c.error_yaw << ", " << c.pairs << ", " << c.noise_along_across.x() << ", " << c.noise_along_across.y() << ", " << c.noise_yaw;
     out << "]\n";
   }
   return out.str();
@@ -219,24 +231,26 @@ NdtQualityMap NdtQualityMap::parse(const std::string& text, const std::string& s
   const long long reach = static_cast<long long>(kMaxCoordinate / map.cell_) + 1;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const std::string key = "cells[" + std::to_string(i) + "]";
-    const std::size_t entries = cells[i].IsSequence() && cells[i].size() == 10 ? 10 : 4;
+    const std::size_t entries = cells[i].IsSequence() && cells[i].size() == 11 ? 11 : 4;
     const std::vector<double> v = r.numbers(cells[i], key, entries,
-                                            entries == 10 ? "[i, j, poses, variance, error_along, error_across, pairs, noise_along, noise_across, noise_yaw]" : "[i, j, poses, variance]");
+                                            entries == 11 ? "[i, j, poses, variance, error_along, error_across, error_yaw, pairs, noise_along, noise_across, noise_yaw]"
+                                                          : "[i, j, poses, variance]");
     for (int k = 0; k < 3; ++k)
       if (!(std::isfinite(v[k]) && v[k] == std::floor(v[k]) && std::abs(v[k]) <= static_cast<double>(reach)))
         r.fail(cells[i], key, "i, j and poses must be whole numbers, i and j within the map's reach (1e9 m)");
     if (v[2] < 1.0) r.fail(cells[i], key, "a cell holds at least one pose");
     if (!(v[3] >= 0.0 && v[3] <= kMaxVariance)) r.fail(cells[i], key, "the variance must be a finite number of m^2 >= 0");
     Cell c{v[3], static_cast<std::size_t>(v[2])};
-    if (entries == 10) {
+    if (entries == 11) {
       if (!map.noise_along_across_ || !map.noise_yaw_) r.fail(cells[i], key, "a cell's noise needs the map's noise_along, noise_across and noise_yaw");
-      if (!(v[6] >= 1.0 && v[6] == std::floor(v[6]) && v[6] <= v[2])) r.fail(cells[i], key, "pairs must be a whole number from 1 to the cell's poses");
-      for (int k : {4, 5, 7, 8, 9})
+      if (!(v[7] >= 1.0 && v[7] == std::floor(v[7]) && v[7] <= v[2])) r.fail(cells[i], key, "pairs must be a whole number from 1 to the cell's poses");
+      for (int k : {4, 5, 6, 8, 9, 10})
         if (!(v[k] >= 0.0 && v[k] <= kMaxVariance)) r.fail(cells[i], key, "the error and noise figures must be finite numbers >= 0");
       c.error_along_across = Eigen::Vector2d(v[4], v[5]);
-      c.pairs = static_cast<std::size_t>(v[6]);
-      c.noise_along_across = Eigen::Vector2d(v[7], v[8]);
-      c.noise_yaw = v[9];
+      c.error_yaw = v[6];
+      c.pairs = static_cast<std::size_t>(v[7]);
+      c.noise_along_across = Eigen::Vector2d(v[8], v[9]);
+      c.noise_yaw = v[10];
     }
     const std::pair<long long, long long> index{static_cast<long long>(v[0]), static_cast<long long>(v[1])};
     if (!map.cells_.emplace(index, c).second) r.fail(cells[i], key, "the cell appears twice");

@@ -617,6 +617,7 @@ struct Pipeline::Impl {
     // own topic, plots): at its place's whole error, which the bias's share is part of.
     PoseMeasurement alone = pose;
     if (place > 0.0) alone.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(pose.covariance.topLeftCorner<2, 2>(), place);
+    if (const std::optional<double> yaw = at_noise ? ndt_quality.yawErrorAt(at) : std::nullopt) alone.covariance(5, 5) = std::max(alone.covariance(5, 5), *yaw);
     if (floor > 0.0) {
       const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
       pose.covariance.topLeftCorner<2, 2>() = principalVariancesAtLeast(xy, floor);

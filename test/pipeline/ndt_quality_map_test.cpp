@@ -174,6 +174,8 @@ TEST(NdtQualityMap, EachCellMeasuresItsOwnNoiseAndErrorDrawnTowardsTheMedianCell
   const Eigen::Matrix2d error = *m.errorAt({25.0, 5.0}, 0.0);
   EXPECT_NEAR(error(0, 0), 0.0025 + 1e-4, 0.0004);
   EXPECT_NEAR(error(1, 1), 0.0004 + 1e-6, 0.00005);
+  EXPECT_NEAR(*m.yawErrorAt({25.0, 5.0}), 9e-6 + 9e-8, 1e-6) << "NDT's yaw 3 mrad off and its noise";
+  EXPECT_FALSE(m.yawErrorAt({500.0, 500.0}));
   // Where no cell measured: the map's figures, and no error by direction.
   EXPECT_NEAR((*m.noiseAt({500.0, 500.0}, 0.0))(0, 0), m.noiseAlongAcross()->x(), 1e-15);
   EXPECT_EQ(*m.yawNoiseAt({500.0, 500.0}), *m.yawNoise());
@@ -185,6 +187,7 @@ TEST(NdtQualityMap, EachCellMeasuresItsOwnNoiseAndErrorDrawnTowardsTheMedianCell
     EXPECT_TRUE(read.noiseAt(at, 0.3)->isApprox(*m.noiseAt(at, 0.3), 1e-12));
     EXPECT_TRUE(read.errorAt(at, 0.3)->isApprox(*m.errorAt(at, 0.3), 1e-12));
     EXPECT_NEAR(*read.yawNoiseAt(at), *m.yawNoiseAt(at), 1e-20);
+    EXPECT_NEAR(*read.yawErrorAt(at), *m.yawErrorAt(at), 1e-20);
   }
   // Samples without NDT's yaw error measure no cell's noise: the map's along and across serve.
   for (NdtQualitySample& sample : s) sample.yaw_error = std::nan("");
@@ -195,11 +198,11 @@ TEST(NdtQualityMap, EachCellMeasuresItsOwnNoiseAndErrorDrawnTowardsTheMedianCell
 
 TEST(NdtQualityMap, ACellsNoiseThatCannotBeIsRefusedNamingTheCell) {
   const std::string head = "cell: 10\ndefault_variance: 0.01\nnoise_variance: 1e-4\nnoise_along: 1e-4\nnoise_across: 1e-6\nnoise_yaw: 1e-7\ncells:\n";
-  EXPECT_NO_THROW(NdtQualityMap::parse(head + "  - [0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, 1e-6, 1e-7]\n", "q.yaml"));
-  for (const std::string row : {"[0, 0, 10, 1e-3, 2e-3, 1e-5, 0, 1e-4, 1e-6, 1e-7]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, 11, 1e-4, 1e-6, 1e-7]",
-                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 2.5, 1e-4, 1e-6, 1e-7]", "[0, 0, 10, 1e-3, -2e-3, 1e-5, 9, 1e-4, 1e-6, 1e-7]",
-                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, .nan, 1e-7]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, 1e-6, .inf]",
-                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4]"}) {
+  EXPECT_NO_THROW(NdtQualityMap::parse(head + "  - [0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 9, 1e-4, 1e-6, 1e-7]\n", "q.yaml"));
+  for (const std::string row : {"[0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 0, 1e-4, 1e-6, 1e-7]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 11, 1e-4, 1e-6, 1e-7]",
+                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 2.5, 1e-4, 1e-6, 1e-7]", "[0, 0, 10, 1e-3, -2e-3, 1e-5, 4e-6, 9, 1e-4, 1e-6, 1e-7]",
+                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 9, 1e-4, .nan, 1e-7]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 9, 1e-4, 1e-6, .inf]",
+                                "[0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 9, 1e-4]", "[0, 0, 10, 1e-3, 2e-3, 1e-5, -4e-6, 9, 1e-4, 1e-6, 1e-7]"}) {
     try {
       NdtQualityMap::parse(head + "  - " + row + "\n", "q.yaml");
       ADD_FAILURE() << row << " accepted";
@@ -208,7 +211,7 @@ TEST(NdtQualityMap, ACellsNoiseThatCannotBeIsRefusedNamingTheCell) {
     }
   }
   // A cell's noise without the map's to fall back on.
-  EXPECT_THROW(NdtQualityMap::parse("cell: 10\ndefault_variance: 0.01\ncells:\n  - [0, 0, 10, 1e-3, 2e-3, 1e-5, 9, 1e-4, 1e-6, 1e-7]\n", "q.yaml"), Error);
+  EXPECT_THROW(NdtQualityMap::parse("cell: 10\ndefault_variance: 0.01\ncells:\n  - [0, 0, 10, 1e-3, 2e-3, 1e-5, 4e-6, 9, 1e-4, 1e-6, 1e-7]\n", "q.yaml"), Error);
 }
 
 TEST(NdtQualityMap, ItsFileReadsBackToTheSameMap) {

@@ -484,12 +484,13 @@ TEST(LogReplay, NdtAtItsNoiseTakesEachPoseBetweenItsPlacesNoiseAndItsErrorInEach
   }
   EXPECT_EQ(seen, 3);
   EXPECT_GE(noise.pipeline_report.ndt_quality_lowered, 1u) << "where NDT's fit claimed more across than NDT was there";
-  // On their own (for the smoother, NDT's topic) the poses stay at their place's whole error, and
-  // so does the filter's in the default mode.
+  // On their own (for the smoother, NDT's topic) the poses stay at their place's whole error, in yaw
+  // too (1 mrad off, its square and its noise's), and so does the filter's in the default mode.
   for (const auto& [name, pose] : noise.filter_poses) {
     if (name != pipeline::kNdtSource) continue;
     const double trace = pose.covariance.topLeftCorner<2, 2>().trace();
     EXPECT_GE(trace, 2.0 * map.varianceAt(here) * (1.0 - 1e-9));
+    EXPECT_NEAR(pose.covariance(5, 5), *map.yawErrorAt(pose.pose.position.head<2>()), 1e-12) << "its yaw at its place's whole yaw error";
   }
   for (const auto& [name, pose] : error.weighed_poses) {
     if (name != pipeline::kNdtSource) continue;
