@@ -5,10 +5,12 @@
 #include <chrono>
 #include <mutex>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 
 #include "coloc/core/error.hpp"
+#include "coloc/core/principal_variances.hpp"
 #include "target_impl.hpp"
 
 namespace coloc::ndt {
@@ -227,13 +229,7 @@ double nvtlAt(const NdtTarget::Impl& t, const std::vector<Eigen::Vector3f>& sour
 // The smallest symmetric matrix (in the floor's metric) that is at least both: the estimate's
 // eigenvalues, seen through the floor's whitening, clamped at 1.
 Eigen::Matrix2d floorCovariance(const Eigen::Matrix2d& estimate, const Eigen::Matrix2d& floor) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> f(floor);
-  const Eigen::Vector2d sd = f.eigenvalues().cwiseSqrt();
-  const Eigen::Matrix2d whiten = sd.cwiseInverse().asDiagonal() * f.eigenvectors().transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> w(whiten * estimate * whiten.transpose());
-  const Eigen::Vector2d clamped = w.eigenvalues().cwiseMax(1.0);
-  const Eigen::Matrix2d unwhiten = f.eigenvectors() * sd.asDiagonal();
-  return unwhiten * w.eigenvectors() * clamped.asDiagonal() * w.eigenvectors().transpose() * unwhiten.transpose();
+  return clampedInMetric(estimate, floor, 1.0, std::numeric_limits<double>::infinity());
 }
 
 // Autoware's MULTI_NDT_SCORE, with yaw probes: NVTL at offset poses, softmax weights (the optimum

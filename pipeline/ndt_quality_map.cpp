@@ -124,10 +124,17 @@ NdtQualityMap NdtQualityMap::fromErrors(const std::vector<NdtQualitySample>& sam
   return map;
 }
 
+namespace {
+// Variances along and across a vehicle heading `heading` (rad), as an x/y covariance in the map.
+Eigen::Matrix2d turnedToMap(const Eigen::Vector2d& along_across, double heading) {
+  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(heading).toRotationMatrix();  // the vehicle's axes in the map
+  return turn * along_across.asDiagonal() * turn.transpose();
+}
+}  // namespace
+
 std::optional<Eigen::Matrix2d> NdtQualityMap::noiseAt(double heading) const {
   if (!noise_along_across_ || !std::isfinite(heading)) return std::nullopt;
-  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(heading).toRotationMatrix();  // the vehicle's axes in the map
-  return turn * noise_along_across_->asDiagonal() * turn.transpose();
+  return turnedToMap(*noise_along_across_, heading);
 }
 
 void NdtQualityMap::setNoisePrior() {
@@ -155,15 +162,13 @@ std::optional<Eigen::Matrix2d> NdtQualityMap::noiseAt(const Eigen::Vector2d& xy,
     const double n = static_cast<double>(c->pairs);
     along_across = (n * c->noise_along_across + kNoisePriorPairs * noise_prior_.head<2>()) / (n + kNoisePriorPairs);
   }
-  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(heading).toRotationMatrix();  // the vehicle's axes in the map
-  return turn * along_across.asDiagonal() * turn.transpose();
+  return turnedToMap(along_across, heading);
 }
 
 std::optional<Eigen::Matrix2d> NdtQualityMap::errorAt(const Eigen::Vector2d& xy, double heading) const {
   const Cell* c = cellAt(xy);
   if (!c || c->pairs == 0 || !std::isfinite(heading)) return std::nullopt;
-  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(heading).toRotationMatrix();
-  return turn * c->error_along_across.asDiagonal() * turn.transpose();
+  return turnedToMap(c->error_along_across, heading);
 }
 
 std::optional<double> NdtQualityMap::yawErrorAt(const Eigen::Vector2d& xy) const {

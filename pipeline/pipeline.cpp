@@ -513,8 +513,11 @@ struct Pipeline::Impl {
   // Whether the bias is told apart at `stamp`: a roadside fix within its length of travel, or the
   // odometry's slow errors modelled as states (handle() says why).
   bool biasToldApart(Stamp stamp, const std::optional<fusion::Estimate>& now) const {
-    const double hold = config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0);
-    return config.fusion.modelsOdometryErrors() || (last_anchor && stamp - *last_anchor <= fromSeconds(hold));
+    return config.fusion.modelsOdometryErrors() || (last_anchor && stamp - *last_anchor <= biasHold(now));
+  }
+  // The time a fix tells the bias apart for: its length of travel at the filter's speed (1 m/s at least).
+  Duration biasHold(const std::optional<fusion::Estimate>& now) const {
+    return fromSeconds(config.fusion.map_match_bias_length / std::max(now ? std::abs(now->linear_velocity.x()) : 0.0, 1.0));
   }
 
   // Before a roadside fix that tells NDT's bias apart where NDT's poses followed it (ndt.quality_floor:
@@ -526,8 +529,7 @@ struct Pipeline::Impl {
     const std::optional<fusion::Estimate> now = localizer.estimate();
     if (!now || biasToldApart(stamp, now)) return;
     // Once for a stretch of fixes the filter refuses: each would let it in again.
-    const double hold = config.fusion.map_match_bias_length / std::max(std::abs(now->linear_velocity.x()), 1.0);
-    if (last_release && stamp >= *last_release && stamp - *last_release <= fromSeconds(hold)) return;
+    if (last_release && stamp >= *last_release && stamp - *last_release <= biasHold(now)) return;
     last_release = stamp;
     const double spread = biasSpreadAt(now->pose.position.head<2>(), rollPitchYaw(now->pose.orientation)[2]);
     localizer.setMapMatchBiasVariance(spread);
@@ -568,12 +570,13 @@ struct Pipeline::Impl {
     // odometry_yaw_rate_bias_sd), the odometry is what the filter says it is, and the bias is loose
     // everywhere.
     const Eigen::Vector2d at = pose.pose.position.head<2>();
+    const double yaw = rollPitchYaw(pose.pose.orientation)[2];  // NDT's, the mounting yaw taken out
     const double place = ndt_quality.varianceAt(at);
     const bool at_noise = place > 0.0 && config.ndt.quality_floor == "noise";
     // NDT's scan-to-scan noise here, along and across the vehicle turned to the map by NDT's own
     // heading, and in yaw; a pose floored at it where its bias is followed or held apart.
     const std::optional<Eigen::Matrix2d> noise = place > 0.0 && (at_noise || config.ndt.quality_noise_by_direction)
-                                                     ? ndt_quality.noiseAt(at, rollPitchYaw(pose.pose.orientation)[2])
+                                                     ? ndt_quality.noiseAt(at, yaw)
                                                      : std::nullopt;
     const auto floorAtNoise = [&] {
       if (!noise) return false;
@@ -588,7 +591,7 @@ struct Pipeline::Impl {
     // 1e-4), and trusted at that NDT's poses count for nothing along the road and its figure there
     // is 0.1-0.3. In a cutting the reference drive's error is NDT's slide and the cap stays high.
     const auto capAtError = [&] {
-      const std::optional<Eigen::Matrix2d> error = ndt_quality.errorAt(at, rollPitchYaw(pose.pose.orientation)[2]);
+      const std::optional<Eigen::Matrix2d> error = ndt_quality.errorAt(at, yaw);
       if (!noise || !error) return;
       const Eigen::Matrix2d xy = pose.covariance.topLeftCorner<2, 2>();
       pose.covariance.topLeftCorner<2, 2>() = coveringAtLeast(coveredAtMost(xy, *error), *noise);
@@ -607,7 +610,7 @@ struct Pipeline::Impl {
       const bool told_apart = biasToldApart(pose.stamp, now);
       double spread = 0.0;
       if (told_apart) {
-        spread = biasSpreadAt(at, rollPitchYaw(pose.pose.orientation)[2]);
+        spread = biasSpreadAt(at, yaw);
         if (place > 0.0) floor = ndt_quality.noiseVariance();
         if (noise && (at_noise || floorAtNoise())) floor = 0.0;
       }
@@ -627,7 +630,6 @@ struct Pipeline::Impl {
     // A pose with nothing to compare yet is taken at no better than the unverified figure.
     // The odometry's travel is laid along the direction of motion: NDT's yaw plus the filter's yaw bias
     // (a LiDAR turned 0.6 deg from its calibration puts a 4 m chord 4 cm aside of NDT's own heading).
-    const double yaw = rollPitchYaw(pose.pose.orientation)[2];
     const std::optional<Eigen::Vector2d> excess =
         travel_check.check(pose.stamp, pose.pose.position.head<2>(), yaw + (now ? now->yaw_bias : 0.0));
     if (!excess) {

@@ -35,22 +35,31 @@ inline Eigen::Matrix2d coveringAtLeast(const Eigen::Matrix2d& covariance, const 
   return symmetric + mapPrincipalVariances(floor - symmetric, [](double v) { return v > 0.0 ? v : 0.0; });
 }
 
-/// At most `covariance` and at most `ceiling` in every direction: in the space where the ceiling is
-/// round (whitened by it), the covariance's principal variances above 1 taken down to 1. Below the
-/// ceiling it is unchanged; it keeps its shape where it can. A ceiling with no variance in some
-/// direction holds the result to none there.
+/// `covariance` seen in `metric`'s whitening (where the metric is round), its principal variances
+/// clamped to [lo, hi] there, and turned back: lo = 1 gives the smallest covariance at least both
+/// (NDT's score floored at its fixed matrix), hi = 1 the largest at most both. The metric must have
+/// no empty direction.
+inline Eigen::Matrix2d clampedInMetric(const Eigen::Matrix2d& covariance, const Eigen::Matrix2d& metric, double lo, double hi) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> f(metric);
+  const Eigen::Vector2d sd = f.eigenvalues().cwiseSqrt();
+  const Eigen::Matrix2d whiten = sd.cwiseInverse().asDiagonal() * f.eigenvectors().transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> w(whiten * covariance * whiten.transpose());
+  const Eigen::Vector2d clamped = w.eigenvalues().cwiseMax(lo).cwiseMin(hi);
+  const Eigen::Matrix2d unwhiten = f.eigenvectors() * sd.asDiagonal();
+  return unwhiten * w.eigenvectors() * clamped.asDiagonal() * w.eigenvectors().transpose() * unwhiten.transpose();
+}
+
+/// At most `covariance` and at most `ceiling` in every direction (clampedInMetric to [0, 1]). Below
+/// the ceiling it is unchanged; it keeps its shape where it can. A ceiling with no variance in some
+/// direction holds the result to a billionth of its other there.
 inline Eigen::Matrix2d coveredAtMost(const Eigen::Matrix2d& covariance, const Eigen::Matrix2d& ceiling) {
   const Eigen::Matrix2d symmetric = 0.5 * (covariance + covariance.transpose());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> c(0.5 * (ceiling + ceiling.transpose()));
   if (c.info() != Eigen::Success) return symmetric;
   const double top = std::max(c.eigenvalues()[1], 0.0);
   if (!(top > 0.0)) return Eigen::Matrix2d::Zero();
-  // The ceiling's square root and its inverse; a direction it leaves empty kept a billionth of its other.
-  const Eigen::Vector2d root = c.eigenvalues().cwiseMax(1e-18 * top).cwiseSqrt();
-  const Eigen::Matrix2d unwhiten = c.eigenvectors() * root.asDiagonal() * c.eigenvectors().transpose();
-  const Eigen::Matrix2d whiten = c.eigenvectors() * root.cwiseInverse().asDiagonal() * c.eigenvectors().transpose();
-  const Eigen::Matrix2d capped = mapPrincipalVariances(whiten * symmetric * whiten, [](double v) { return std::clamp(v, 0.0, 1.0); });
-  const Eigen::Matrix2d out = unwhiten * capped * unwhiten;
+  const Eigen::Vector2d held = c.eigenvalues().cwiseMax(1e-18 * top);
+  const Eigen::Matrix2d out = clampedInMetric(symmetric, c.eigenvectors() * held.asDiagonal() * c.eigenvectors().transpose(), 0.0, 1.0);
   return 0.5 * (out + out.transpose());
 }
 
