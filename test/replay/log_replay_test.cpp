@@ -353,10 +353,6 @@ ReplayResult replayAgainstThePairsMap(const std::string& log, const std::string&
 }
 
 // Where the pair's source scan lies on its target map (the pair's ground truth), x and y.
-Eigen::Vector2d wherePairsScansMatch() {
-  const Eigen::Matrix4d gt1 = testing::readMatrix4(testing::realData("hdl32e_pair/T_target_source.gt1.txt"));
-  return {gt1(0, 3), gt1(1, 3)};
-}
 
 // NDT's error by place (ndt.quality_map): where a drive with a reference found NDT poor, its poses are
 // worth no more than that, whatever their fit says; elsewhere they are as NDT gives them. A map that
@@ -364,7 +360,7 @@ Eigen::Vector2d wherePairsScansMatch() {
 TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
   testing::TempDir dir;
   writeScanLog(dir / "scans", 3);
-  const Eigen::Vector2d here = wherePairsScansMatch();
+  const Eigen::Vector2d here = testing::wherePairsScansMatch();
   // One cell (10 m) around where the scans are matched, NDT 0.5 m off there on the reference drive;
   // another far away.
   std::vector<pipeline::NdtQualitySample> samples;
@@ -443,7 +439,7 @@ TEST(LogReplay, NdtPosesWhereTheQualityMapFoundNdtPoorAreTakenAtItsVariance) {
 TEST(LogReplay, NdtAtItsNoiseTakesEachPoseBetweenItsPlacesNoiseAndItsErrorInEachDirection) {
   testing::TempDir dir;
   writeScanLog(dir / "scans", 3);
-  const Eigen::Vector2d here = wherePairsScansMatch();
+  const Eigen::Vector2d here = testing::wherePairsScansMatch();
   // The reference drive, eastward through the cell: NDT 5 cm ahead with 1 cm of noise along, 1 mm to
   // the left with 0.5 mm across, its yaw 1 mrad off with 1 mrad of noise.
   std::vector<pipeline::NdtQualitySample> samples;

@@ -6,14 +6,15 @@
 
 namespace coloc::testing {
 
-inline rsu_client::RsuRegistry oneRsu(const Eigen::Vector2d& position, double coverage, const std::string& id = "rsu_a") {
+inline rsu_client::RsuRegistry oneRsu(const Eigen::Vector2d& position, double coverage, const std::string& id = "rsu_a",
+                                      rsu_client::CovariancePlacement placement = rsu_client::CovariancePlacement::kPublished) {
   rsu_client::RsuInfo rsu;
   rsu.id = id;
   rsu.position = position;
   rsu.lidar = *rsu_client::findLidarModel("VLP-32C");
   rsu.coverage_radius = coverage;
   rsu.identity = "CN=" + id;
-  return rsu_client::RsuRegistry({rsu}, rsu_client::CovariancePlacement::kPublished);
+  return rsu_client::RsuRegistry({rsu}, placement);
 }
 
 }  // namespace coloc::testing

@@ -27,6 +27,13 @@ inline Eigen::Matrix4d readMatrix4(const std::string& path) {
   return m;
 }
 
+/// Where the HDL-32E pair's source scan lies in its target (x, y of the reference transform): where
+/// NDT puts a vehicle whose scan it is, with the target as the map.
+inline Eigen::Vector2d wherePairsScansMatch() {
+  const Eigen::Matrix4d gt1 = readMatrix4(realData("hdl32e_pair/T_target_source.gt1.txt"));
+  return {gt1(0, 3), gt1(1, 3)};
+}
+
 /// Translation distance and rotation angle (degrees) between two rigid transforms.
 inline std::pair<double, double> poseDifference(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
   const Eigen::Matrix4d d = a.inverse() * b;
