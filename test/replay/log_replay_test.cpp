@@ -352,8 +352,6 @@ ReplayResult replayAgainstThePairsMap(const std::string& log, const std::string&
   return replayLog(log, options);
 }
 
-// Where the pair's source scan lies on its target map (the pair's ground truth), x and y.
-
 // NDT's error by place (ndt.quality_map): where a drive with a reference found NDT poor, its poses are
 // worth no more than that, whatever their fit says; elsewhere they are as NDT gives them. A map that
 // cannot be read stops the replay before anything is fused, naming the file.
