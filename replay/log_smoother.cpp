@@ -1,6 +1,7 @@
 #include "coloc/replay/log_smoother.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <set>
@@ -18,9 +19,9 @@ smoother::SmootherOptions smootherOptionsFor(const pipeline::Config& config, boo
   const pipeline::SmootherSection& c = config.smoother;
   smoother::SmootherOptions o;
   o.rate = filter.predict_frequency;
-  o.proc_stddev_yaw_c = filter.proc_stddev_yaw_c;
-  o.proc_stddev_vx_c = filter.proc_stddev_vx_c;
-  o.proc_stddev_wz_c = filter.proc_stddev_wz_c;
+  o.proc_stddev_yaw_c = std::max(filter.proc_stddev_yaw_c, smoother::SmootherOptions::kLeastProcessNoise);
+  o.proc_stddev_vx_c = std::max(filter.proc_stddev_vx_c, smoother::SmootherOptions::kLeastProcessNoise);
+  o.proc_stddev_wz_c = std::max(filter.proc_stddev_wz_c, smoother::SmootherOptions::kLeastProcessNoise);
   o.initial_yaw_bias_variance = filter.initial_yaw_bias_variance;
   o.robust = filter.pose_gate_alpha > 0.0;
   if (o.robust) o.gate_alpha = filter.pose_gate_alpha;
@@ -83,6 +84,8 @@ void smoothFixedLag(const SmoothOptions& options, SmoothResult& result) {
       if (twist.stamp >= begin && twist.stamp <= end) s.addTwist(source, twist);
     const auto t0 = std::chrono::steady_clock::now();
     const smoother::SmootherResult r = s.solve(f.fused_states[start_index].first, end);
+    if (!r.summary.usable())
+      throw Error("smooth: the window ending at " + formatSeconds(end) + " s: the solver found no solution (" + r.summary.report + ")");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++report.windows;
     report.mean_solve_seconds += seconds;
@@ -165,6 +168,7 @@ SmoothResult smoothLog(const std::string& log_path, SmoothOptions options) {
     for (const rsu_client::RsuInfo& rsu : registry->rsus()) s.calibrateRsu(rsu_client::fixTopic(rsu.id), rsu.position);
   }
   const smoother::SmootherResult r = s.solve(f.fused_states.front().first, f.fused_states.back().first);
+  if (!r.summary.usable()) throw Error("smooth: " + log_path + ": the solver found no solution (" + r.summary.report + ")");
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.summary = r.summary;
   result.odometry = r.odometry;

@@ -196,6 +196,15 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   const SmootherOptions& o = impl_->options;
   if (impl_->guesses.empty()) throw Error("smoother: no first guess of the states (addGuess)");
   if (last <= first) throw Error("smoother: the span to smooth is empty");
+  const auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0.0))
+      throw Error(std::string("smoother: ") + name + " must be finite and > 0 (the motion is weighed by its inverse; a zero one is an infinite weight)");
+  };
+  positive(o.proc_stddev_yaw_c, "proc_stddev_yaw_c");
+  positive(o.proc_stddev_vx_c, "proc_stddev_vx_c");
+  positive(o.proc_stddev_wz_c, "proc_stddev_wz_c");
+  positive(o.proc_stddev_position_c, "proc_stddev_position_c");
+  positive(o.proc_stddev_yaw_bias_c, "proc_stddev_yaw_bias_c");
   const Duration step = static_cast<Duration>(std::llround(1e9 / o.rate));
   const std::size_t n = static_cast<std::size_t>((last - first) / step) + 1;
   SmootherResult result;

@@ -800,6 +800,18 @@ namespace {
 
 // The configuration file's smoother section and the library's SmootherOptions start from the same
 // values: a user of either gets the same smoother.
+TEST(SmootherConfiguration, AFiltersZeroProcessNoiseIsTakenAtTheSmoothersLeast) {
+  // A heading that is its yaw rate's integral (fusion.proc_stddev_yaw_c: 0) is the filter's to take;
+  // the smoother weighs the motion by its inverse and takes its least instead.
+  pipeline::Config config;
+  config.fusion.proc_stddev_yaw_c = 0.0;
+  config.fusion.proc_stddev_wz_c = 0.0;
+  const smoother::SmootherOptions o = smootherOptionsFor(config);
+  EXPECT_EQ(o.proc_stddev_yaw_c, smoother::SmootherOptions::kLeastProcessNoise);
+  EXPECT_EQ(o.proc_stddev_wz_c, smoother::SmootherOptions::kLeastProcessNoise);
+  EXPECT_EQ(o.proc_stddev_vx_c, config.fusion.proc_stddev_vx_c) << "a figure above the least as the filter's";
+}
+
 TEST(SmootherConfiguration, TheFilesDefaultsAreTheLibrarysDefaults) {
   const smoother::SmootherOptions library;
   const pipeline::Config defaults;

@@ -1,9 +1,13 @@
 #include "coloc/smoother/smoother.hpp"
 
+#include "coloc/core/error.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 namespace coloc::smoother {
 namespace {
@@ -65,6 +69,29 @@ TEST(Smoother, AFixIsComparedWithTheStateAtItsExactStamp) {
     EXPECT_NEAR(s.state[0], kSpeed * t, 0.005) << "at " << t << " s";
     EXPECT_NEAR(s.state[1], 0.0, 0.005) << "at " << t << " s";
   }
+}
+
+TEST(Smoother, AProcessNoiseThatIsNotPositiveIsRefusedNamingIt) {
+  // The motion is weighed by the inverse of its process noise: at zero the solver would evaluate an
+  // infinite weight and give back its first guess as if solved.
+  const std::vector<std::pair<const char*, double SmootherOptions::*>> figures = {
+      {"proc_stddev_yaw_c", &SmootherOptions::proc_stddev_yaw_c},         {"proc_stddev_vx_c", &SmootherOptions::proc_stddev_vx_c},
+      {"proc_stddev_wz_c", &SmootherOptions::proc_stddev_wz_c},           {"proc_stddev_position_c", &SmootherOptions::proc_stddev_position_c},
+      {"proc_stddev_yaw_bias_c", &SmootherOptions::proc_stddev_yaw_bias_c}};
+  for (const auto& [name, field] : figures)
+    for (const double bad : {0.0, -1.0, std::nan("")}) {
+      SmootherOptions options;
+      options.*field = bad;
+      Smoother s(options);
+      s.addGuess(at(0.0), truth(0.0));
+      s.addGuess(at(0.02), truth(0.02));
+      try {
+        s.solve(at(0.0), at(0.02));
+        ADD_FAILURE() << name << " = " << bad << " taken";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      }
+    }
 }
 
 TEST(Smoother, AnInfiniteVarianceLeavesItsComponentOutExactly) {

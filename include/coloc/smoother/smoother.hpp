@@ -28,6 +28,10 @@ struct SmootherOptions {
   /// weight, so they get this much (small: the motion model's own error, not a source of freedom).
   double proc_stddev_position_c = 0.02;  ///< m/s
   double proc_stddev_yaw_bias_c = 1e-4;  ///< rad/s
+  /// The least of each process noise the smoother takes from a filter whose figure is zero (a heading
+  /// that is its yaw rate's integral): a batch problem weighs the motion by its inverse, and zero would
+  /// be an infinite weight the solver cannot evaluate. Per second, in each figure's own unit.
+  static constexpr double kLeastProcessNoise = 1e-4;
   /// Motion between states by the trapezoid rule (exact for constant acceleration); false: the filter's
   /// forward step, its model exactly (the smoother then reproduces the filter's last state on a linear
   /// problem).
