@@ -15,6 +15,7 @@ const std::vector<EkfParam>& ekfParams() {
       {"proc_stddev_vx_c", "m/s^2", "speed process noise", &C::proc_stddev_vx_c},
       {"proc_stddev_wz_c", "rad/s^2", "yaw-rate process noise", &C::proc_stddev_wz_c},
       {"yaw_bias_walk", "rad/sqrt(s)", "the yaw bias's random walk (its variance grows by walk^2 per second); 0 = constant (Autoware)", &C::yaw_bias_walk},
+      {"yaw_rate_sampling_noise", "", "each twist adds to the yaw variance the heading's error from a yaw rate that changed since the last twist at an unknown moment, (change x interval)^2 / 12; off = Autoware", &C::yaw_rate_sampling_noise},
       {"pose_smoothing_steps", "ticks", "a pose is applied over this many ticks, each with covariance x steps", &C::pose_smoothing_steps},
       {"max_pose_queue_size", "poses", "poses of one source being smoothed at once; the oldest is folded in when full", &C::max_pose_queue_size},
       {"twist_smoothing_steps", "ticks", "as pose_smoothing_steps, for twists", &C::twist_smoothing_steps},

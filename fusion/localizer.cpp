@@ -97,6 +97,8 @@ struct Localizer::Impl {
     int gated_in_a_row = 0;
     int smoothing_steps = 0;  ///< 0: the configuration's for the kind
     bool anchor = false;      ///< independent of the vehicle's map matching (see integrity.hpp)
+    /// A twist source's newest yaw rate taken in, and its stamp (EkfConfig::yaw_rate_sampling_noise).
+    std::optional<std::pair<Stamp, double>> last_yaw_rate;
   };
   // A measurement still being applied over its smoothing steps.
   struct Active {
@@ -147,7 +149,9 @@ struct Localizer::Impl {
                     (kind == SourceKind::kPose ? "twist" : "pose") + " source");
       return it->second;
     }
-    sources.push_back({name, kind, {}});
+    sources.emplace_back();
+    sources.back().name = name;
+    sources.back().kind = kind;
     sources.back().smoothing_steps = smoothing_steps;
     sources.back().anchor = anchor;
     by_name.emplace(name, static_cast<SourceId>(sources.size() - 1));
@@ -359,6 +363,25 @@ struct Localizer::Impl {
     }
   }
 
+  // The heading's error from a yaw rate that changed since the source's previous twist at a moment
+  // between the two (uniform): (change x interval)^2 / 12. A twist older than the newest taken adds
+  // nothing; it is within an interval already counted.
+  static double samplingVariance(Source& src, Stamp stamp, const UpdateRecord& record) {
+    for (int i = 0; i < record.m; ++i) {
+      if (record.index[i] != kWz) continue;
+      const double wz = record.value[i];
+      double added = 0.0;
+      if (src.last_yaw_rate && stamp <= src.last_yaw_rate->first) return 0.0;
+      if (src.last_yaw_rate) {
+        const double turned = (wz - src.last_yaw_rate->second) * toSeconds(stamp - src.last_yaw_rate->first);
+        added = turned * turned / 12.0;
+      }
+      src.last_yaw_rate = std::make_pair(stamp, wz);
+      return added;
+    }
+    return 0.0;
+  }
+
   Verdict feed(SourceId id, SourceKind kind, Stamp stamp, const RecordOrError& made) {
     if (id < 0 || static_cast<std::size_t>(id) >= sources.size()) {
       ++unknown_sources;
@@ -390,12 +413,14 @@ struct Localizer::Impl {
       return reject(id, stamp, Reason::kFromFuture,
                     "stamp is " + formatSeconds(stamp - clock) + " s ahead of the clock (tolerance " +
                         formatSeconds(future_tolerance) + " s)");
-    if (auto back = history.ticksBack(stamp)) return firstUse(id, stamp, record, *back);
-    if (stamp < history.latestStamp()) {
+    const std::optional<int> back = history.ticksBack(stamp);
+    if (!back && stamp < history.latestStamp()) {
       return reject(id, stamp, Reason::kTooOld,
                     "stamp is " + formatSeconds(history.latestStamp() - stamp) + " s behind the newest tick; the history reaches back " +
                         formatSeconds(history.latestStamp() - history.oldestStamp()) + " s");
     }
+    if (kind == SourceKind::kTwist && config.yaw_rate_sampling_noise) record.yaw_variance_added = samplingVariance(src, stamp, record);
+    if (back) return firstUse(id, stamp, record, *back);
     pending.push_back({id, stamp, record});
     ++src.counters.pending;
     return accept(id, stamp, Outcome::kPending, -1, 0.0, "waits for the filter's clock to reach its stamp");
@@ -546,7 +571,7 @@ void Localizer::reset() {
   d.initialized = false;
   d.clock_set = false;
   d.clock = 0;
-  for (Impl::Source& s : d.sources) s.gated_in_a_row = 0;
+  for (Impl::Source& s : d.sources) s.gated_in_a_row = 0, s.last_yaw_rate.reset();
   d.integrity.restart(0, false);
 }
 

@@ -210,6 +210,8 @@ NormalizedInnovation normalizedInnovation(const FilterState& state, const Update
 }
 
 bool applyUpdate(FilterState& state, const UpdateRecord& record) {
+  // Smoothing applies a record `scale` times: each takes its share, and together the whole.
+  if (record.yaw_variance_added > 0.0) state.P(kYaw, kYaw) += record.yaw_variance_added / record.scale;
   if (record.m > 0) {
     const Model mdl = model(state, record);
     const Innovation in = innovationWith(state, record, mdl, record.scale);

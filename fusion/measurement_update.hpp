@@ -25,6 +25,9 @@ struct UpdateRecord {
   /// The pose measures the position plus the map-matching bias (a source that is not an anchor), where
   /// the state models it (FilterState::bias); otherwise ignored.
   bool biased = false;
+  /// rad^2; added to the yaw variance before the update, a share per use (EkfConfig::
+  /// yaw_rate_sampling_noise: a twist's yaw rate changed since the source's previous one).
+  double yaw_variance_added = 0.0;
 };
 
 /// Innovation e = y - H x (angles wrapped) and its covariance S = H P H^T + R (R unscaled).
