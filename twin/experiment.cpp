@@ -521,6 +521,28 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
   std::vector<std::string> reference_errors(config.sites.size());  // per site, recorded: that drive's input_error.csv
   std::vector<double> ndt_quality_default(config.sites.size(), 0.0);  // and its mean square over the drive
 
+  // What the site's noise calibration drive measured of NDT, into a replay's configuration.
+  auto takeNdtFigures = [&](pipeline::Config& replay, std::size_t site) {
+    const auto& v = ndt_variance[site];
+    if (!v) return;
+    Vector6d& cov = replay.ndt.source.ndt.fixed_covariance;
+    cov[0] = cov[1] = (*v)[0];
+    if (config.ndt_covariance == NdtCovarianceSource::kEstimated) cov[5] = (*v)[1];
+    if (config.ndt_covariance != NdtCovarianceSource::kMultiNdtScore) return;
+    replay.ndt.source.ndt.covariance = ndt::CovarianceMode::kMultiNdtScore;
+    if (ndt_quality[site].empty()) {
+      replay.ndt.source.ndt.covariance_floor = cov;  // NDT's error on the calibration drive the floor
+      return;
+    }
+    // NDT's error on the calibration drive where the pose is the floor; the aligner's own at its default.
+    replay.ndt.quality_map = ndt_quality[site];
+    if (config.map_match_bias_length > 0.0) {
+      // Its spread before the first pose is looked up: the drive's mean square.
+      replay.fusion.map_match_bias_sd = std::sqrt(std::max(ndt_quality_default[site], 1e-6));
+      replay.fusion.map_match_bias_length = config.map_match_bias_length;
+    }
+  };
+
   // Drive d + 1 is simulated while drive d's replays run: the simulation is mostly one thread.
   struct Recorded {
     sim::Scenario scenario;
@@ -631,17 +653,33 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     for (Job& j : jobs) {
       results.timing.replay += j.run.replay_seconds;
       if (drive.variant == kNoiseCalibrationDrive) {
-        ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
+        const pipeline::Config first = j.config;  // before it took any of what the drive measures
+        for (int pass = 1;; ++pass) {
+          ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
+          const bool by_place = config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore;
+          const bool last = !by_place || pass >= config.ndt_quality_passes;
+          if (by_place) {
+            // The evaluated drives' map under its own name, an earlier pass's (which the next replayed
+            // with) under its pass's.
+            const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
+            const std::string file = last ? "/ndt_quality.yaml" : "/ndt_quality_pass_" + std::to_string(pass) + ".yaml";
+            ndt_quality[drive.site] = fs::absolute(rec.out_dir + file).lexically_normal().string();
+            std::ofstream(ndt_quality[drive.site]) << quality.toYaml();
+            ndt_quality_default[drive.site] = quality.defaultVariance();
+            results.ndt_quality_cells[scenario.name] = quality.cells();
+          }
+          if (last) break;
+          // Again with what this pass measured, as the evaluated drives take it.
+          j.config = first;
+          takeNdtFigures(j.config, drive.site);
+          j.run.variant = variant + ", pass " + std::to_string(pass + 1);
+          if (config.recordings) writeReplayConfig(j, rec.out_dir + "/replays");
+          runJob(j);
+          results.timing.replay += j.run.replay_seconds;
+        }
         results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
         accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(replay::AccuratePlaces::fromErrors(
             j.ndt_errors, j.run.ndt.stretch_length, j.run.ndt.accurate_below, replay::AccuratePlaces::kMinPoses));
-        if (config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
-          const pipeline::NdtQualityMap quality = replay::ndtQualityMap(j.ndt_errors);
-          ndt_quality[drive.site] = fs::absolute(rec.out_dir + "/ndt_quality.yaml").lexically_normal().string();
-          std::ofstream(ndt_quality[drive.site]) << quality.toYaml();
-          ndt_quality_default[drive.site] = quality.defaultVariance();
-          results.ndt_quality_cells[scenario.name] = quality.cells();
-        }
         continue;  // never evaluated
       }
       if (j.calibrate && j.registry) {
@@ -778,25 +816,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       if (job.places && config.recordings) job.config.replay.input_reference = reference_errors[drive.site];
       job.config.rsu.checks.station_id = scenario.vehicle_station_id;  // the ego takes the fixes addressed to it
       job.rsu_positions = rsu_positions;
-      if (const auto& v = ndt_variance[drive.site]) {
-        Vector6d& cov = job.config.ndt.source.ndt.fixed_covariance;
-        cov[0] = cov[1] = (*v)[0];
-        if (config.ndt_covariance == NdtCovarianceSource::kEstimated) cov[5] = (*v)[1];
-        if (config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore) {
-          job.config.ndt.source.ndt.covariance = ndt::CovarianceMode::kMultiNdtScore;
-          if (!ndt_quality[drive.site].empty()) {
-            // NDT's error on the calibration drive where the pose is the floor; the aligner's own at its default.
-            job.config.ndt.quality_map = ndt_quality[drive.site];
-            if (config.map_match_bias_length > 0.0) {
-              // Its spread before the first pose is looked up: the drive's mean square.
-              job.config.fusion.map_match_bias_sd = std::sqrt(std::max(ndt_quality_default[drive.site], 1e-6));
-              job.config.fusion.map_match_bias_length = config.map_match_bias_length;
-            }
-          } else {
-            job.config.ndt.source.ndt.covariance_floor = cov;  // NDT's error on the calibration drive the floor
-          }
-        }
-      }
+      takeNdtFigures(job.config, drive.site);
       if (config.twist_covariance_estimated) {
         pipeline::InputConfig twist;
         twist.role = pipeline::InputRole::kTwist;

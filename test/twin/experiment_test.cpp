@@ -111,6 +111,11 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_NE(errorOf("map_match_bias_length: -5\n").find("exp.yaml:1: map_match_bias_length: must be in [0, 10000]"), std::string::npos)
       << errorOf("map_match_bias_length: -5\n");
   EXPECT_NE(errorOf("map_match_bias_length: .nan\n").find("map_match_bias_length"), std::string::npos);
+  EXPECT_EQ(parseExperimentConfig("", "exp.yaml").ndt_quality_passes, 1) << "the noise calibration drive replayed once";
+  EXPECT_EQ(parseExperimentConfig("ndt_quality_passes: 3\n", "exp.yaml").ndt_quality_passes, 3);
+  EXPECT_NE(errorOf("ndt_quality_passes: 0\n").find("exp.yaml:1: ndt_quality_passes: must be in [1, 10]"), std::string::npos)
+      << errorOf("ndt_quality_passes: 0\n");
+  EXPECT_NE(errorOf("ndt_quality_passes: 1.5\n").find("exp.yaml:1: ndt_quality_passes"), std::string::npos) << errorOf("ndt_quality_passes: 1.5\n");
 }
 
 TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideIt) {
@@ -126,10 +131,13 @@ TEST(ExperimentConfig, ShippedPaperConfigurationLoadsWithItsFuseFileFoundBesideI
 TEST(ExperimentConfig, ShippedNdtAtItsNoiseConfigurationLoadsWithItsFuseFileFoundBesideIt) {
   const ExperimentConfig c = loadExperimentConfig(COLOC_SOURCE_DIR "/config/experiments/ndt_at_its_noise.yaml");
   EXPECT_TRUE(c.twist_covariance_estimated);
+  EXPECT_EQ(c.ndt_quality_passes, 2) << "NDT measured again under the filter that takes its map";
   EXPECT_EQ(c.ndt_covariance, NdtCovarianceSource::kMultiNdtScore) << "the experiment's own, which hands each replay its quality map";
   const pipeline::Config fuse = pipeline::loadConfig(c.fuse_config);
   EXPECT_EQ(fuse.ndt.quality_floor, "noise");
   EXPECT_DOUBLE_EQ(fuse.fusion.yaw_bias_walk, 0.002);
+  EXPECT_DOUBLE_EQ(fuse.fusion.proc_stddev_yaw_c, 0.0) << "the twin's heading is its yaw rate's integral";
+  EXPECT_TRUE(fuse.fusion.yaw_rate_sampling_noise);
   EXPECT_TRUE(fuse.pipeline.speed_scale_uncertainty);
   EXPECT_DOUBLE_EQ(fuse.pipeline.travel_check_turn_tolerance, 0.002);
   EXPECT_EQ(fuse.fusion.pose_gate_recovery, 3) << "the experiment's base, which a fuse file replaces whole";

@@ -62,6 +62,11 @@ struct ExperimentConfig {
   /// drive's one figure for the whole site, which hid NDT's good matches where the rest of the site
   /// is poor (`ndt_quality_map: by_place | site`).
   bool ndt_quality_by_place = true;
+  /// How often the noise calibration drive is replayed to measure NDT by place: NDT's match depends
+  /// on the guess it starts from (in a weak direction it stays near it), and the guesses on the first
+  /// replay are those of a filter without the map. Each further replay takes the map the last one
+  /// measured, as the evaluated drives do, and measures it again (`ndt_quality_passes`; 1 = once).
+  int ndt_quality_passes = 1;
   /// With NDT's error by place: the bias NDT's poses share as the filter's own state
   /// (fusion.map_match_bias_sd, its spread per place from that map, each pose at NDT's scan-to-scan
   /// noise from the same drive), fading over this much travel; 0 = not modelled, each pose floored at
