@@ -369,9 +369,9 @@ struct Localizer::Impl {
   static double samplingVariance(Source& src, Stamp stamp, const UpdateRecord& record) {
     for (int i = 0; i < record.m; ++i) {
       if (record.index[i] != kWz) continue;
+      if (src.last_yaw_rate && stamp <= src.last_yaw_rate->first) return 0.0;
       const double wz = record.value[i];
       double added = 0.0;
-      if (src.last_yaw_rate && stamp <= src.last_yaw_rate->first) return 0.0;
       if (src.last_yaw_rate) {
         const double turned = (wz - src.last_yaw_rate->second) * toSeconds(stamp - src.last_yaw_rate->first);
         added = turned * turned / 12.0;

@@ -644,6 +644,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     const auto t1 = f.t1;
     std::vector<Job>& jobs = f.jobs;
     const std::shared_ptr<replay::ReplayCache>& cache = f.cache;
+    std::size_t replays_again = 0;  // the noise calibration drive's further passes
     {
       const ndt::AlignmentMemoStats shared = cache->alignments()->stats();
       results.timing.matches_asked += shared.asked;
@@ -654,9 +655,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       results.timing.replay += j.run.replay_seconds;
       if (drive.variant == kNoiseCalibrationDrive) {
         const pipeline::Config first = j.config;  // before it took any of what the drive measures
+        const bool by_place = config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore;
         for (int pass = 1;; ++pass) {
           ndt_variance[drive.site] = ndtVariance(j.run.ndt, scenario.name);
-          const bool by_place = config.ndt_quality_by_place && config.ndt_covariance == NdtCovarianceSource::kMultiNdtScore;
           const bool last = !by_place || pass >= config.ndt_quality_passes;
           if (by_place) {
             // The evaluated drives' map under its own name, an earlier pass's (which the next replayed
@@ -676,6 +677,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           if (config.recordings) writeReplayConfig(j, rec.out_dir + "/replays");
           runJob(j);
           results.timing.replay += j.run.replay_seconds;
+          ++replays_again;
         }
         results.estimated_ndt_variance[scenario.name] = *ndt_variance[drive.site];
         accurate_places[drive.site] = std::make_shared<const replay::AccuratePlaces>(replay::AccuratePlaces::fromErrors(
@@ -707,12 +709,12 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
       }
       results.runs.push_back(std::move(j.run));
     }
-    results.timing.replays += jobs.size();
+    results.timing.replays += jobs.size() + replays_again;
     if (progress.fraction) progress.fraction(static_cast<double>(d + 1) / drives.size());
     if (progress.step) {
       char line[256];
       std::snprintf(line, sizeof line, "[%zu/%zu] %s%s%s: drive simulated in %.1f s, %zu replays in %.1f s", d + 1, drives.size(),
-                    name.c_str(), variant.empty() ? "" : ", ", variant.c_str(), simulated_in, jobs.size(), since(t1));
+                    name.c_str(), variant.empty() ? "" : ", ", variant.c_str(), simulated_in, jobs.size() + replays_again, since(t1));
       progress.step(line);
     }
   };
