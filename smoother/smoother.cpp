@@ -85,7 +85,19 @@ struct Smoother::Impl {
   }
 };
 
-Smoother::Smoother(SmootherOptions options) : impl_(std::make_unique<Impl>()) { impl_->options = options; }
+Smoother::Smoother(SmootherOptions options) : impl_(std::make_unique<Impl>()) {
+  // The motion is weighed by the inverse of each process noise: refused when given, not at a solve.
+  const auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0.0))
+      throw Error(std::string("smoother: ") + name + " must be finite and > 0 (the motion is weighed by its inverse; a zero one is an infinite weight)");
+  };
+  positive(options.proc_stddev_yaw_c, "proc_stddev_yaw_c");
+  positive(options.proc_stddev_vx_c, "proc_stddev_vx_c");
+  positive(options.proc_stddev_wz_c, "proc_stddev_wz_c");
+  positive(options.proc_stddev_position_c, "proc_stddev_position_c");
+  positive(options.proc_stddev_yaw_bias_c, "proc_stddev_yaw_bias_c");
+  impl_->options = options;
+}
 Smoother::~Smoother() = default;
 Smoother::Smoother(Smoother&&) noexcept = default;
 Smoother& Smoother::operator=(Smoother&&) noexcept = default;
@@ -196,15 +208,6 @@ SmootherResult Smoother::solveWith(Stamp first, Stamp last, const std::vector<bo
   const SmootherOptions& o = impl_->options;
   if (impl_->guesses.empty()) throw Error("smoother: no first guess of the states (addGuess)");
   if (last <= first) throw Error("smoother: the span to smooth is empty");
-  const auto positive = [](double v, const char* name) {
-    if (!(std::isfinite(v) && v > 0.0))
-      throw Error(std::string("smoother: ") + name + " must be finite and > 0 (the motion is weighed by its inverse; a zero one is an infinite weight)");
-  };
-  positive(o.proc_stddev_yaw_c, "proc_stddev_yaw_c");
-  positive(o.proc_stddev_vx_c, "proc_stddev_vx_c");
-  positive(o.proc_stddev_wz_c, "proc_stddev_wz_c");
-  positive(o.proc_stddev_position_c, "proc_stddev_position_c");
-  positive(o.proc_stddev_yaw_bias_c, "proc_stddev_yaw_bias_c");
   const Duration step = static_cast<Duration>(std::llround(1e9 / o.rate));
   const std::size_t n = static_cast<std::size_t>((last - first) / step) + 1;
   SmootherResult result;

@@ -142,6 +142,7 @@ struct SmootherResult {
 
 class Smoother {
  public:
+  /// Throws coloc::Error naming a process noise that is not finite and > 0.
   explicit Smoother(SmootherOptions options = {});
   ~Smoother();
   Smoother(Smoother&&) noexcept;
