@@ -1,4 +1,4 @@
-#include "cam_size_correction.hpp"
+#include "coloc/pipeline/cam_size_correction.hpp"
 
 #include "coloc/io/v2x_messages.hpp"
 

@@ -15,7 +15,7 @@
 #include "inbox.hpp"
 #include "initializer.hpp"
 #include "speed_scale.hpp"
-#include "cam_size_correction.hpp"
+#include "coloc/pipeline/cam_size_correction.hpp"
 #include "fix_agreement.hpp"
 #include "coloc/pipeline/ndt_quality_map.hpp"
 #include "travel_check.hpp"

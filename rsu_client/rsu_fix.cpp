@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <sstream>
 
@@ -204,23 +205,37 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
     return reject(FixRejection::kDuplicate, "a fix with this stamp was already received", c.duplicate);
   seen.push_back(fix.stamp);
   ++c.passed_checks;
-  const double variance = registry_.variance(*rsu);
+  const Eigen::Matrix2d calibrated = registry_.covarianceAt(*rsu, Eigen::Vector2d(fix.x, fix.y));
   v.measurement.stamp = fix.stamp;
   v.measurement.pose.position = {fix.x, fix.y, 0.0};
   v.measurement.covariance = Matrix6d::Zero();
-  v.measurement.covariance.diagonal() << variance, variance, kInfinity, kInfinity, kInfinity, kInfinity;
+  v.measurement.covariance.diagonal() << 0.0, 0.0, kInfinity, kInfinity, kInfinity, kInfinity;
+  v.measurement.covariance.topLeftCorner<2, 2>() = calibrated;
   // What the RSU sent of this fix (checked: at least the registry's figure). The vehicle's own
   // calibration of this RSU replaces that figure, the floor an RSU raises each principal variance of
   // its fit to; what a fix says beyond it (its own fit's doubt along a direction: a car far off, one
-  // face seen) is this fix's and stays, at least the calibrated variance.
+  // face seen) is this fix's and stays, at least what the calibration says along that direction.
   if (fix.sent) {
     const Eigen::Matrix2d sent = fix.sent->covariance.topLeftCorner<2, 2>();
     if (!rsu->calibrated_variance) {
       v.measurement.covariance.topLeftCorner<2, 2>() = sent;
     } else {
       const double figure = registry_.lidarVariance(*rsu) * (1.0 + 1e-6);
-      v.measurement.covariance.topLeftCorner<2, 2>() =
-          mapPrincipalVariances(sent, [&](double sent_variance) { return sent_variance > figure ? std::max(sent_variance, variance) : variance; });
+      if (rsu->calibrated_error_by_range.empty()) {
+        const double variance = calibrated(0, 0);
+        v.measurement.covariance.topLeftCorner<2, 2>() =
+            mapPrincipalVariances(sent, [&](double sent_variance) { return sent_variance > figure ? std::max(sent_variance, variance) : variance; });
+      } else if (const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> principal(sent); principal.eigenvalues().maxCoeff() > figure) {
+        // Sent at the figure on both axes (the fit knew no more): the calibration's covariance as it
+        // is, whichever axes an isotropic matrix happens to be decomposed on (this branch not taken).
+        Eigen::Matrix2d taken = Eigen::Matrix2d::Zero();
+        for (int i = 0; i < 2; ++i) {
+          const Eigen::Vector2d axis = principal.eigenvectors().col(i);
+          const double sent_variance = principal.eigenvalues()(i), calibration = axis.dot(calibrated * axis);
+          taken += (sent_variance > figure ? std::max(sent_variance, calibration) : calibration) * axis * axis.transpose();
+        }
+        v.measurement.covariance.topLeftCorner<2, 2>() = taken;
+      }
     }
   }
   return v;

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -34,7 +35,7 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
   const std::string where = "rsus[" + std::to_string(index) + "]";
   r.allowKeys(node, where,
               {"id", "position", "height", "yaw_deg", "roll_deg", "pitch_deg", "lidar_model", "coverage_radius", "identity", "calibrated_variance",
-               "calibration"});
+               "calibrated_error_by_range", "calibration"});
   RsuInfo rsu;
   bool has_position = false, has_model = false;
   std::optional<double> radius;
@@ -69,6 +70,18 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
       rsu.identity = r.text(entry.second, full);
     } else if (key == "calibrated_variance") {
       rsu.calibrated_variance = r.positive(entry.second, full);
+    } else if (key == "calibrated_error_by_range") {
+      if (!entry.second.IsSequence() || entry.second.size() == 0)
+        r.fail(entry.second, full, "expected a list of [range m, sd along m, sd across m], by increasing range");
+      for (std::size_t i = 0; i < entry.second.size(); ++i) {
+        const std::string row = full + "[" + std::to_string(i) + "]";
+        const auto v = r.numbers(entry.second[i], row, 3, "[range m, sd along the line of sight m, sd across it m]");
+        if (!(v[0] >= 0.0 && v[0] <= 1000.0)) r.fail(entry.second[i], row, "the range must be within 0-1000 m");
+        if (!(v[1] > 0.0 && v[1] <= 10.0 && v[2] > 0.0 && v[2] <= 10.0)) r.fail(entry.second[i], row, "each standard deviation must be within (0, 10] m");
+        if (!rsu.calibrated_error_by_range.empty() && !(v[0] > rsu.calibrated_error_by_range.back().range))
+          r.fail(entry.second[i], row, "the ranges must increase from row to row");
+        rsu.calibrated_error_by_range.push_back({v[0], v[1], v[2]});
+      }
     } else if (key == "calibration") {
       r.allowKeys(entry.second, full, {"dx", "dy", "dyaw_deg", "clock_offset_ms"});
       RsuCalibrationEntry c;
@@ -86,6 +99,8 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
   if (rsu.id.empty()) r.fail(node, where, "needs an id");
   if (!has_position) r.fail(node, where + " (" + rsu.id + ")", "needs a position");
   if (!has_model) r.fail(node, where + " (" + rsu.id + ")", "needs a lidar_model");
+  if (!rsu.calibrated_error_by_range.empty() && !rsu.calibrated_variance)
+    r.fail(node, where + ".calibrated_error_by_range", "needs calibrated_variance: the error by range is part of the same calibration");
   for (char c : rsu.id)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
       r.fail(node, where + ".id", "'" + rsu.id + "': use letters, digits and _ (it becomes part of a DDS topic name)");
@@ -166,6 +181,11 @@ std::string RsuRegistry::toYaml() const {
         << "    coverage_radius: " << number(r.coverage_radius) << "\n"
         << "    identity: \"" << r.identity << "\"\n";
     if (r.calibrated_variance) out << "    calibrated_variance: " << number(*r.calibrated_variance) << "\n";
+    if (!r.calibrated_error_by_range.empty()) {
+      out << "    calibrated_error_by_range:  # [range m, sd along the line of sight m, sd across it m]\n";
+      for (const RsuInfo::ErrorAtRange& e : r.calibrated_error_by_range)
+        out << "      - [" << number(e.range) << ", " << number(e.along_sd) << ", " << number(e.across_sd) << "]\n";
+    }
     if (r.calibration)
       out << "    calibration: {dx: " << number(r.calibration->dx) << ", dy: " << number(r.calibration->dy)
           << ", dyaw_deg: " << number(r.calibration->dyaw * 180.0 / M_PI) << ", clock_offset_ms: " << number(r.calibration->clock_offset * 1e3)
@@ -181,6 +201,22 @@ const RsuInfo* RsuRegistry::find(const std::string& id) const {
 }
 
 double RsuRegistry::variance(const RsuInfo& rsu) const { return rsu.calibrated_variance ? *rsu.calibrated_variance : lidarVariance(rsu); }
+
+Eigen::Matrix2d RsuRegistry::covarianceAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const {
+  const std::vector<RsuInfo::ErrorAtRange>& table = rsu.calibrated_error_by_range;
+  const Eigen::Vector2d sight = fix - rsu.position;
+  const double range = sight.norm();
+  if (!rsu.calibrated_variance || table.empty() || !(range > 0.0)) return variance(rsu) * Eigen::Matrix2d::Identity();
+  // The variances interpolated in range between the rows about it; the end rows hold beyond them.
+  auto upper = std::upper_bound(table.begin(), table.end(), range, [](double r, const RsuInfo::ErrorAtRange& e) { return r < e.range; });
+  const RsuInfo::ErrorAtRange& hi = upper == table.end() ? table.back() : *upper;
+  const RsuInfo::ErrorAtRange& lo = upper == table.begin() ? table.front() : *std::prev(upper);
+  const double w = hi.range > lo.range ? (range - lo.range) / (hi.range - lo.range) : 0.0;
+  const double along = (1.0 - w) * lo.along_sd * lo.along_sd + w * hi.along_sd * hi.along_sd;
+  const double across = (1.0 - w) * lo.across_sd * lo.across_sd + w * hi.across_sd * hi.across_sd;
+  const Eigen::Vector2d u = sight / range, v(-u.y(), u.x());
+  return along * u * u.transpose() + across * v * v.transpose();
+}
 
 double RsuRegistry::lidarVariance(const RsuInfo& rsu) const {
   return placement_ == CovariancePlacement::kPublished ? rsu.lidar.sigma : rsu.lidar.sigma * rsu.lidar.sigma;

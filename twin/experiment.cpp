@@ -19,11 +19,13 @@
 #include "coloc/rsu_client/rsu_registry.hpp"
 #include "coloc/sim/scene.hpp"
 #include "coloc/sim/vehicle_motion.hpp"
+#include "coloc/pipeline/cam_size_correction.hpp"
 #include "coloc/pipeline/config.hpp"
 #include "coloc/replay/accurate_places.hpp"
 #include "coloc/replay/log_replay.hpp"
 #include "coloc/replay/log_smoother.hpp"
 #include "coloc/rsu_client/dds_transport.hpp"
+#include "coloc/rsu_client/fix_error_model.hpp"
 #include "coloc/twin/twin_recording.hpp"
 
 namespace coloc::twin {
@@ -364,6 +366,9 @@ class JobPool {
 // are the gate's business, not the covariance's.
 // None from fewer than kFewestFixes fixes (an RSU the drive hardly passes).
 constexpr std::size_t kFewestFixes = 5;
+// The fixes' error by range is measured in bands of this many metres: one pass of the noise
+// calibration drive puts 10-20 fixes in each at 10 m/s and 10 Hz.
+constexpr double kFixErrorBand = 10.0;
 std::optional<double> robustFixVariance(const std::vector<Eigen::Vector2d>& errors) {
   if (errors.size() < kFewestFixes) return std::nullopt;
   std::vector<double> abs_errors;
@@ -513,6 +518,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
     results.sites.push_back(siteInfo(scenarios.back()));
   }
   std::vector<std::map<std::string, double>> measured_variance(config.sites.size());  // per site: RSU id -> variance
+  std::vector<std::map<std::string, std::vector<rsu_client::RsuInfo::ErrorAtRange>>> measured_error_by_range(config.sites.size());
   std::vector<Eigen::Vector2d> twist_variance(config.sites.size(), Eigen::Vector2d::Zero());  // per site: vx, wz
   std::vector<std::optional<Eigen::Vector2d>> ndt_variance(config.sites.size());  // per site: x/y, yaw
   std::vector<std::string> ndt_quality(config.sites.size());  // per site: NDT's error by place (its file)
@@ -839,6 +845,9 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           job.fix_sources.push_back(rsu_client::fixTopic(r.id));
           rsu_client::RsuInfo info = registryEntry(r);
           info.calibrated_variance = varianceFor(how, r);
+          if (how == RsuCovariance::kEstimated && info.calibrated_variance)
+            if (const auto b = measured_error_by_range[drive.site].find(r.id); b != measured_error_by_range[drive.site].end())
+              info.calibrated_error_by_range = b->second;
           const bool same_installation = drive.variant.empty() || drive.variant == "RSU height" || drive.variant == "speed";
           if (const auto c = commissioned.find({drive.site, r.id}); same_installation && c != commissioned.end())
             info.calibration = c->second.calibration;
@@ -925,10 +934,28 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           rsu_client::RsuInfo calibrated = entry;
           calibrated.calibration = c.found.calibration;
           commissioned[{drive.site, r.id}] = calibrated;
-          // The fixes' variance as the filter will see them.
-          if (const auto v = meanSquareFixVariance(residuals)) {
+          // The fixes' variance as the filter will see them: after the vehicle has taken its CAM's
+          // rounding of its size back (rsu.vehicle_length, rsu.vehicle_width), which moves a fix by a
+          // centimetre or two towards the end and side the RSU sees and is no error of the fixes the
+          // filter gets (site E's VLP-32C within 10 m: 1.5 cm along the road as sent, 0.6 cm taken).
+          // With rsu_fix_error: by_range also by range, along and across the line of sight.
+          const pipeline::CamSizeCorrection cam{fuse.rsu.vehicle_length, fuse.rsu.vehicle_width, fuse.rsu.cam_size_step, fuse.rsu.cam_length,
+                                                fuse.rsu.cam_width};
+          std::vector<Eigen::Vector2d> at, taken = residuals;
+          for (std::size_t i = 0; i < sent.size(); ++i) {
+            at.push_back(sent[i].fix);
+            const Eigen::Vector2d& v = sent[i].velocity;
+            if (cam.enabled() && i < taken.size() && v.norm() > 0.1)
+              taken[i] += cam.apply(sent[i].fix, entry.position, std::atan2(v.y(), v.x())) - sent[i].fix;
+          }
+          const std::vector<rsu_client::RsuInfo::ErrorAtRange> by_range =
+              config.rsu_fix_error_by_range ? rsu_client::fixErrorByRange(entry.position, at, taken, kFixErrorBand, kFewestFixes)
+                                            : std::vector<rsu_client::RsuInfo::ErrorAtRange>{};
+          if (const auto v = meanSquareFixVariance(taken)) {
             measured_variance[drive.site][r.id] = *v;
             results.estimated_variance[reportKey(scenario, r)] = *v;
+            if (by_range.empty()) measured_error_by_range[drive.site].erase(r.id);
+            else measured_error_by_range[drive.site][r.id] = by_range;
           }
         }
     } else if (drive.variant.empty()) {
@@ -988,6 +1015,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           exact.clock_offset = 0.0;
           rsu_client::RsuInfo info = registryEntry(exact);
           info.calibrated_variance = perfect.registry->find(r.id)->calibrated_variance;
+          info.calibrated_error_by_range = perfect.registry->find(r.id)->calibrated_error_by_range;
           twins.push_back(info);
           perfect.fix_topics.push_back(twin);
           perfect.fix_sources.push_back(rsu_client::fixTopic(perfectRsuId(r.id)));

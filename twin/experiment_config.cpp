@@ -96,12 +96,13 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     } else if (key == "calibration_clock_offset_ms") c.calibration_clock_offset_ms = r.inRange(v, key, -1000.0, 1000.0);
     else if (key == "oracle_fix_limit") c.oracle_fix_limit = r.inRange(v, key, 0.0, 100.0);
     else if (key == "rsu_background") c.rsu_background_learned = r.choice(v, key, {"learned", "surveyed"}) == "learned";
+    else if (key == "rsu_fix_error") c.rsu_fix_error_by_range = r.choice(v, key, {"by_range", "flat"}) == "by_range";
     else if (key == "ndt_quality_map") c.ndt_quality_by_place = r.choice(v, key, {"by_place", "site"}) == "by_place";
     else if (key == "map_match_bias_length") c.map_match_bias_length = r.inRange(v, key, 0.0, 10000.0);
     else if (key == "ndt_quality_passes") c.ndt_quality_passes = static_cast<int>(r.integer(v, key, 1, 10));
     else r.fail(entry.first, key, "unknown key (sites, trials, lidars, delays, losses, network, network_trials, rsu_covariance, gate_recovery, bin_length, fuse_config, jobs, sweeps, "
                                   "sweep_trials, rsu_heights, speeds, smoother, recordings, calibration, calibration_error, calibration_clock_offset_ms, twist_covariance, ndt_covariance, error_sources, errors, rsu_calibration, "
-                                  "oracle_fix_limit, rsu_background, ndt_quality_map, ndt_quality_passes, map_match_bias_length)");
+                                  "oracle_fix_limit, rsu_background, rsu_fix_error, ndt_quality_map, ndt_quality_passes, map_match_bias_length)");
   }
   if (c.delays.front() != 0.0 || c.losses.front() != 0.0)
     throwConfigError(source_name, -1, "delays/losses", "the first delay and the first loss must be 0: the ideal network is the reference");

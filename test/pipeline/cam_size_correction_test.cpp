@@ -1,6 +1,6 @@
 // A fix placed with the CAM's rounded size is moved back to the body's own centre, on the side and end
 // the RSU sees; abeam, the end is not guessed.
-#include "cam_size_correction.hpp"
+#include "coloc/pipeline/cam_size_correction.hpp"
 
 #include <gtest/gtest.h>
 

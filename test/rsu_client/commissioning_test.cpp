@@ -7,6 +7,7 @@
 #include <random>
 
 #include "coloc/rsu_client/commissioning.hpp"
+#include "coloc/rsu_client/fix_error_model.hpp"
 
 namespace coloc::rsu_client {
 namespace {
@@ -94,6 +95,45 @@ TEST(Commissioning, TooFewFixesDetermineNothing) {
   const CommissioningResult r = commissionRsu({100, 0}, std::vector<CommissioningSample>(samples.begin(), samples.begin() + 5));
   EXPECT_FALSE(r.determined);
   EXPECT_NE(r.note.find("fewer than"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace coloc::rsu_client
+
+namespace coloc::rsu_client {
+namespace {
+
+// Fixes 3-50 m from an RSU with 1 cm along the line of sight and, across it, 1 cm plus 1.5 mrad of
+// bearing: each 10 m band gives both back at its mean range within their sampling spread (about 5 %
+// over some 800 fixes a band); a residual that is NaN is left out, not taken as 0, and a band with
+// too few fixes gives no row.
+TEST(FixErrorModel, EachRangeBandGivesTheErrorAlongAndAcrossTheLineOfSight) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<double> range(3.0, 50.0), angle(-M_PI, M_PI);
+  const Eigen::Vector2d rsu(100.0, -5.0);
+  std::vector<Eigen::Vector2d> fixes, residuals;
+  auto across_sd = [](double r) { return std::sqrt(0.01 * 0.01 + std::pow(0.0015 * r, 2)); };
+  for (int i = 0; i < 4000; ++i) {
+    const double r = range(rng), a = angle(rng);
+    const Eigen::Vector2d u(std::cos(a), std::sin(a)), across(-u.y(), u.x());
+    fixes.push_back(rsu + r * u);
+    residuals.push_back(0.01 * unit(rng) * u + across_sd(r) * unit(rng) * across);
+  }
+  fixes.push_back(rsu + Eigen::Vector2d(0, 70));  // alone in the 70-80 m band
+  residuals.push_back(Eigen::Vector2d(0.5, 0.5));
+  residuals[5] = Eigen::Vector2d(std::nan(""), 0.0);
+  const std::vector<RsuInfo::ErrorAtRange> table = fixErrorByRange(rsu, fixes, residuals, 10.0, 5);
+  ASSERT_EQ(table.size(), 5u);  // 0-10 ... 40-50 m; 70-80 m has one fix
+  for (const RsuInfo::ErrorAtRange& row : table) {
+    EXPECT_NEAR(row.along_sd, 0.01, 0.0006) << row.range;
+    // The band's mean square across is the mean of across_sd^2 over its ranges: at its mean range
+    // to within the curvature of r^2 over 10 m (under 1 %).
+    EXPECT_NEAR(row.across_sd, across_sd(row.range), 0.05 * across_sd(row.range)) << row.range;
+  }
+  EXPECT_NEAR(table[2].range, 25.0, 0.5);
+  EXPECT_TRUE(fixErrorByRange(rsu, {fixes.begin(), fixes.begin() + 4}, {residuals.begin(), residuals.begin() + 4}, 10.0, 5).empty());
+  EXPECT_TRUE(fixErrorByRange(rsu, fixes, {residuals.begin(), residuals.begin() + 10}, 10.0, 5).empty());
 }
 
 }  // namespace

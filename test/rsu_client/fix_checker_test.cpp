@@ -254,6 +254,41 @@ TEST(FixChecker, ACalibratedRsusFixKeepsWhatItSaysBeyondItsLidarsFigure) {
   EXPECT_TRUE(std::isinf(v.measurement.covariance(2, 2)));
 }
 
+// A calibration by range: the variance along the line of sight from the RSU and across it, each
+// interpolated in range between its rows and held beyond the last, whichever way the line runs; a
+// fit's own doubt beyond the figure stays where it exceeds what the calibration says along it.
+TEST(FixChecker, ACalibrationByRangeGivesEachFixItsRangesErrorAlongAndAcrossItsLineOfSight) {
+  FixChecker c = acceptingUnaddressed(
+      "rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, coverage_radius: 50, calibrated_variance: 0.0004,\n"
+      "     calibrated_error_by_range: [[5, 0.01, 0.03], [25, 0.01, 0.01], [45, 0.02, 0.08]]}\n");
+  RsuFix east = sentFix(kNow - 1000, 135);  // 35 m east: across is y, halfway between 25 and 45 m
+  FixVerdict v = c.check(east, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), (0.01 * 0.01 + 0.02 * 0.02) / 2.0, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), (0.01 * 0.01 + 0.08 * 0.08) / 2.0, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(0, 1), 0.0, 1e-12);
+  RsuFix north = sentFix(kNow - 900, 100);
+  north.y = 48.0;  // 48 m north, beyond the last row: across is x
+  v = c.check(north, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.08 * 0.08, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.02 * 0.02, 1e-12);
+  RsuFix near = sentFix(kNow - 800, 102);  // 2 m, before the first row: that row's
+  v = c.check(near, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.01 * 0.01, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.03 * 0.03, 1e-12);
+  // Sent 45 m east with its fit's doubt along the line of sight (x: 0.03, beyond the VLP-16's figure
+  // 0.01486) and the figure across: x keeps its 0.03, y takes the calibration's 0.0064.
+  RsuFix doubted = sentFixWith(kNow - 700, 0.03, 0.01486, 0.0);
+  doubted.x = 145.0;
+  v = c.check(doubted, kNow);
+  ASSERT_TRUE(v.accepted()) << v.detail;
+  EXPECT_NEAR(v.measurement.covariance(0, 0), 0.03, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(1, 1), 0.0064, 1e-12);
+  EXPECT_NEAR(v.measurement.covariance(0, 1), 0.0, 1e-12);
+}
+
 TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {
   // Fixes at 10 Hz from a vehicle standing at (105, 1): one arrives 0.4 s late, one is lost. The
   // filter applies the late one at its capture time: the result equals on-time delivery.

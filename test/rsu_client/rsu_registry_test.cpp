@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "coloc/core/error.hpp"
 #include "coloc/rsu_client/rsu_registry.hpp"
 
@@ -44,6 +46,28 @@ TEST(RsuRegistry, CalibratedVarianceOverridesTheModelsFigureWhateverThePlacement
   }
 }
 
+TEST(RsuRegistry, ACalibrationByRangeSurvivesTheFileFormat) {
+  const RsuRegistry r = RsuRegistry::parse(
+      "rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-32C, calibrated_variance: 0.0001,\n"
+      "     calibrated_error_by_range: [[5.5, 0.012, 0.02], [31.25, 0.011, 0.05]]}\n", "rsu.yaml");
+  const RsuRegistry again = RsuRegistry::parse(r.toYaml(), "again");
+  const auto& table = again.find("a")->calibrated_error_by_range;
+  ASSERT_EQ(table.size(), 2u);
+  EXPECT_EQ(table[1].range, 31.25);
+  EXPECT_EQ(table[1].along_sd, 0.011);
+  EXPECT_EQ(table[1].across_sd, 0.05);
+  // 40 m along the diagonal, beyond the last row: 0.05^2 across the line of sight, 0.011^2 along it.
+  const Eigen::Matrix2d c = again.covarianceAt(*again.find("a"), Eigen::Vector2d(40.0, 40.0) / std::sqrt(2.0));
+  EXPECT_NEAR(c(0, 0), (0.011 * 0.011 + 0.05 * 0.05) / 2.0, 1e-12);
+  EXPECT_NEAR(c(0, 1), (0.011 * 0.011 - 0.05 * 0.05) / 2.0, 1e-12);
+  // An RSU without one: its calibrated variance on each axis, wherever the fix.
+  const RsuRegistry flat = RsuRegistry::parse("rsus:\n  - {id: b, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.0002}\n", "x");
+  const Eigen::Matrix2d f = flat.covarianceAt(*flat.find("b"), Eigen::Vector2d(30, 7));
+  EXPECT_EQ(f(0, 0), 0.0002);
+  EXPECT_EQ(f(1, 1), 0.0002);
+  EXPECT_EQ(f(0, 1), 0.0);
+}
+
 TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: HDL-64}\n", "unknown LiDAR model 'HDL-64'");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16}\n  - {id: a, position: [1, 0], lidar_model: VLP-16}\n",
@@ -57,6 +81,19 @@ TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0}\n",
               "rsus[0].calibrated_variance: must be a finite number > 0");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: .nan}\n", "rsus[0].calibrated_variance: must not be NaN");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_error_by_range: [[5, 0.01, 0.01]]}\n",
+              "rsus[0].calibrated_error_by_range: needs calibrated_variance");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: [[5, -0.01, 0.01]]}\n",
+              "rsus[0].calibrated_error_by_range[0]: each standard deviation must be within (0, 10] m");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: [[5, .nan, 0.01]]}\n",
+              "rsus[0].calibrated_error_by_range[0]:");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01,\n"
+              "     calibrated_error_by_range: [[15, 0.01, 0.01], [15, 0.02, 0.02]]}\n",
+              "rsus[0].calibrated_error_by_range[1]: the ranges must increase");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: [[5, 0.01]]}\n",
+              "rsus[0].calibrated_error_by_range[0]");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: []}\n",
+              "rsus[0].calibrated_error_by_range: expected a list");
   expectError("rsu:\n  - {}\n", "rsu: unknown key");
   expectError("? [rsus]\n: []\n", "a key must be plain text");  // found by fuzzing the configs
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibration: {? [dx] : 1}}\n", "a key must be plain text");

@@ -46,6 +46,7 @@ TEST(ExperimentConfig, DefaultsAreThePapersExperiment) {
   EXPECT_FALSE(c.recordings);  // the drives are replayed from memory unless asked
   EXPECT_EQ(c.oracle_fix_limit, 0.0);  // the analysis bound is off
   EXPECT_TRUE(c.rsu_background_learned);  // as an RSU on site learns it, from the busy street
+  EXPECT_FALSE(c.rsu_fix_error_by_range);  // one mean square for every range, until measured over ten trials
   EXPECT_EQ(c.network_trials, 10);  // the grid on every trial: one trial's change spreads by 5-18 points
 }
 
@@ -98,6 +99,9 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_NE(errorOf("recordings: often\n").find("exp.yaml:1: recordings"), std::string::npos) << errorOf("recordings: often\n");
   EXPECT_DOUBLE_EQ(parseExperimentConfig("oracle_fix_limit: 0.02\n", "exp.yaml").oracle_fix_limit, 0.02);
   EXPECT_FALSE(parseExperimentConfig("rsu_background: surveyed\n", "exp.yaml").rsu_background_learned);
+  EXPECT_TRUE(parseExperimentConfig("rsu_fix_error: by_range\n", "exp.yaml").rsu_fix_error_by_range);
+  EXPECT_NE(errorOf("rsu_fix_error: linear\n").find("exp.yaml:1: rsu_fix_error: expected one of by_range, flat"), std::string::npos)
+      << errorOf("rsu_fix_error: linear\n");
   EXPECT_NE(errorOf("rsu_background: empty\n").find("exp.yaml:1: rsu_background: expected one of learned, surveyed"), std::string::npos)
       << errorOf("rsu_background: empty\n");
   EXPECT_NE(errorOf("oracle_fix_limit: -0.02\n").find("exp.yaml:1: oracle_fix_limit: must be in [0, 100]"), std::string::npos)
@@ -132,6 +136,7 @@ TEST(ExperimentConfig, ShippedNdtAtItsNoiseConfigurationLoadsWithItsFuseFileFoun
   const ExperimentConfig c = loadExperimentConfig(COLOC_SOURCE_DIR "/config/experiments/ndt_at_its_noise.yaml");
   EXPECT_TRUE(c.twist_covariance_estimated);
   EXPECT_EQ(c.ndt_quality_passes, 2) << "NDT measured again under the filter that takes its map";
+  EXPECT_TRUE(c.rsu_fix_error_by_range) << "the fixes at their error by range, as the noise calibration drive measures it";
   EXPECT_EQ(c.ndt_covariance, NdtCovarianceSource::kMultiNdtScore) << "the experiment's own, which hands each replay its quality map";
   const pipeline::Config fuse = pipeline::loadConfig(c.fuse_config);
   EXPECT_EQ(fuse.ndt.quality_floor, "noise");

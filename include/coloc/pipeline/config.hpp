@@ -102,7 +102,7 @@ struct RsuSection {
   int smoothing_steps = 0;
   /// This vehicle's own length and width (m): each fix addressed to it is moved back by half what its
   /// CAM's rounding of them to cam_size_step (ETSI: 0.1 m) made the RSU place its box off, on the side
-  /// and end the RSU sees (pipeline/cam_size_correction.hpp). 0: fixes taken as sent.
+  /// and end the RSU sees (coloc/pipeline/cam_size_correction.hpp). 0: fixes taken as sent.
   double vehicle_length = 0.0;
   double vehicle_width = 0.0;
   double cam_size_step = 0.1;  ///< m

@@ -17,7 +17,7 @@
 // CAM's own rounding and the face's shortfall (`tolerance`), the box is placed with it. With the
 // twin's CAMs (the body's size rounded), the experiment's fixes are then unchanged; learning from
 // three frames, one of site C's moved from 17 to 28 cm.
-// The vehicle's own correction of its CAM's rounding (pipeline/cam_size_correction.hpp) assumes the
+// The vehicle's own correction of its CAM's rounding (coloc/pipeline/cam_size_correction.hpp) assumes the
 // CAM's size was used; a side measured instead is the body's, within the tolerance.
 #include <Eigen/Core>
 #include <cmath>

@@ -56,6 +56,17 @@ struct RsuInfo {
   /// x/y variance measured for this RSU (m^2), e.g. by driving a surveyed vehicle past it; when set,
   /// its fixes carry it instead of the model's figure, whatever the placement.
   std::optional<double> calibrated_variance;
+  /// With calibrated_variance: the fixes' error by their range from the RSU (calibrated_error_by_range
+  /// in the file), each row a range (m) and the standard deviations (m) along and across the line of
+  /// sight measured there; a fix between two rows takes the variances interpolated in range, one beyond
+  /// the first or last row that row's. A LiDAR measures range to a centimetre at any distance, but
+  /// its beams thin out and its fit sees other faces as the car passes: what it gets wrong depends on
+  /// the range and the direction, and one figure for all overstates the near fixes and understates the
+  /// far ones (docs/rsu-protocol.md).
+  struct ErrorAtRange {
+    double range = 0.0, along_sd = 0.0, across_sd = 0.0;
+  };
+  std::vector<ErrorAtRange> calibrated_error_by_range;
   std::optional<RsuCalibrationEntry> calibration;
 };
 
@@ -79,6 +90,10 @@ class RsuRegistry {
   /// The x/y variance a fix from this RSU carries: its calibrated variance, else the model's figure
   /// placed as the registry says.
   double variance(const RsuInfo& rsu) const;
+  /// The x/y covariance a fix from this RSU at `fix` (map frame) carries: variance(rsu) on each axis,
+  /// or, where the calibration has it by range, its error at this fix's range along and across the
+  /// line of sight from the RSU.
+  Eigen::Matrix2d covarianceAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const;
   /// The model's figure alone, placed as the registry says: the least an RSU of this LiDAR may send.
   double lidarVariance(const RsuInfo& rsu) const;
 

@@ -116,6 +116,11 @@ struct ExperimentConfig {
   /// each drive, as an RSU on site does (TwinRecordingOptions::rsu_commissioning_frames), or the surveyed
   /// empty street, which no real RSU has (what the twin did before; for comparison).
   bool rsu_background_learned = true;
+  /// With `rsu_covariance: estimated` and the RSUs calibrated (`rsu_fix_error`): `by_range`, the
+  /// fixes' variance along the line of sight and the bearing's spread across it, both measured on the
+  /// noise calibration drive (the registry's calibrated_variance and calibrated_bearing_sd), or `flat`,
+  /// one mean square for every range (the default: by_range is not yet measured over ten trials).
+  bool rsu_fix_error_by_range = false;
 };
 
 /// The quick mode's defaults (`coloc experiment --quick`), a first look at the paper's results:
