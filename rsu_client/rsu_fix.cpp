@@ -226,8 +226,9 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
         v.measurement.covariance.topLeftCorner<2, 2>() =
             mapPrincipalVariances(sent, [&](double sent_variance) { return sent_variance > figure ? std::max(sent_variance, variance) : variance; });
       } else if (const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> principal(sent); principal.eigenvalues().maxCoeff() > figure) {
-        // Sent at the figure on both axes (the fit knew no more): the calibration's covariance as it
-        // is, whichever axes an isotropic matrix happens to be decomposed on (this branch not taken).
+        // One axis sent beyond the figure: it keeps that, at least the calibration's along it, and the
+        // other takes the calibration's. Sent at the figure on both (the fit knew no more), the fix
+        // keeps the calibration's covariance as set above: an isotropic matrix's axes are arbitrary.
         Eigen::Matrix2d taken = Eigen::Matrix2d::Zero();
         for (int i = 0; i < 2; ++i) {
           const Eigen::Vector2d axis = principal.eigenvectors().col(i);
