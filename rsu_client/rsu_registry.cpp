@@ -72,15 +72,18 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
       rsu.calibrated_variance = r.positive(entry.second, full);
     } else if (key == "calibrated_error_by_range") {
       if (!entry.second.IsSequence() || entry.second.size() == 0)
-        r.fail(entry.second, full, "expected a list of [range m, sd along m, sd across m], by increasing range");
+        r.fail(entry.second, full, "expected a list of [range m, sd along m, sd across m(, mean along m, mean across m)], by increasing range");
       for (std::size_t i = 0; i < entry.second.size(); ++i) {
         const std::string row = full + "[" + std::to_string(i) + "]";
-        const auto v = r.numbers(entry.second[i], row, 3, "[range m, sd along the line of sight m, sd across it m]");
+        const bool with_mean = entry.second[i].IsSequence() && entry.second[i].size() == 5;
+        const auto v = r.numbers(entry.second[i], row, with_mean ? 5 : 3,
+                                 "[range m, sd along the line of sight m, sd across it m] or with the mean error along and across it after them");
         if (!(v[0] >= 0.0 && v[0] <= 1000.0)) r.fail(entry.second[i], row, "the range must be within 0-1000 m");
         if (!(v[1] > 0.0 && v[1] <= 10.0 && v[2] > 0.0 && v[2] <= 10.0)) r.fail(entry.second[i], row, "each standard deviation must be within (0, 10] m");
+        if (with_mean && !(std::abs(v[3]) <= 10.0 && std::abs(v[4]) <= 10.0)) r.fail(entry.second[i], row, "each mean error must be within 10 m of 0");
         if (!rsu.calibrated_error_by_range.empty() && !(v[0] > rsu.calibrated_error_by_range.back().range))
           r.fail(entry.second[i], row, "the ranges must increase from row to row");
-        rsu.calibrated_error_by_range.push_back({v[0], v[1], v[2]});
+        rsu.calibrated_error_by_range.push_back({v[0], v[1], v[2], with_mean ? v[3] : 0.0, with_mean ? v[4] : 0.0});
       }
     } else if (key == "calibration") {
       r.allowKeys(entry.second, full, {"dx", "dy", "dyaw_deg", "clock_offset_ms"});
@@ -182,9 +185,12 @@ std::string RsuRegistry::toYaml() const {
         << "    identity: \"" << r.identity << "\"\n";
     if (r.calibrated_variance) out << "    calibrated_variance: " << number(*r.calibrated_variance) << "\n";
     if (!r.calibrated_error_by_range.empty()) {
-      out << "    calibrated_error_by_range:  # [range m, sd along the line of sight m, sd across it m]\n";
-      for (const RsuInfo::ErrorAtRange& e : r.calibrated_error_by_range)
-        out << "      - [" << number(e.range) << ", " << number(e.along_sd) << ", " << number(e.across_sd) << "]\n";
+      out << "    calibrated_error_by_range:  # [range m, sd along the line of sight m, sd across it m(, mean along m, mean across m)]\n";
+      for (const RsuInfo::ErrorAtRange& e : r.calibrated_error_by_range) {
+        out << "      - [" << number(e.range) << ", " << number(e.along_sd) << ", " << number(e.across_sd);
+        if (e.along_bias != 0.0 || e.across_bias != 0.0) out << ", " << number(e.along_bias) << ", " << number(e.across_bias);
+        out << "]\n";
+      }
     }
     if (r.calibration)
       out << "    calibration: {dx: " << number(r.calibration->dx) << ", dy: " << number(r.calibration->dy)
@@ -202,20 +208,38 @@ const RsuInfo* RsuRegistry::find(const std::string& id) const {
 
 double RsuRegistry::variance(const RsuInfo& rsu) const { return rsu.calibrated_variance ? *rsu.calibrated_variance : lidarVariance(rsu); }
 
-Eigen::Matrix2d RsuRegistry::covarianceAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const {
-  const std::vector<RsuInfo::ErrorAtRange>& table = rsu.calibrated_error_by_range;
-  const Eigen::Vector2d sight = fix - rsu.position;
-  const double range = sight.norm();
-  if (!rsu.calibrated_variance || table.empty() || !(range > 0.0)) return variance(rsu) * Eigen::Matrix2d::Identity();
-  // The variances interpolated in range between the rows about it; the end rows hold beyond them.
+namespace {
+
+// The calibration by range at `range`: each figure interpolated between the rows about it (the
+// variances as variances), the end rows held beyond them.
+RsuInfo::ErrorAtRange errorAtRange(const std::vector<RsuInfo::ErrorAtRange>& table, double range) {
   auto upper = std::upper_bound(table.begin(), table.end(), range, [](double r, const RsuInfo::ErrorAtRange& e) { return r < e.range; });
   const RsuInfo::ErrorAtRange& hi = upper == table.end() ? table.back() : *upper;
   const RsuInfo::ErrorAtRange& lo = upper == table.begin() ? table.front() : *std::prev(upper);
-  const double w = hi.range > lo.range ? (range - lo.range) / (hi.range - lo.range) : 0.0;
-  const double along = (1.0 - w) * lo.along_sd * lo.along_sd + w * hi.along_sd * hi.along_sd;
-  const double across = (1.0 - w) * lo.across_sd * lo.across_sd + w * hi.across_sd * hi.across_sd;
+  const double w = hi.range > lo.range ? std::clamp((range - lo.range) / (hi.range - lo.range), 0.0, 1.0) : 0.0;
+  auto mix = [w](double a, double b) { return (1.0 - w) * a + w * b; };
+  return {range, std::sqrt(mix(lo.along_sd * lo.along_sd, hi.along_sd * hi.along_sd)), std::sqrt(mix(lo.across_sd * lo.across_sd, hi.across_sd * hi.across_sd)),
+          mix(lo.along_bias, hi.along_bias), mix(lo.across_bias, hi.across_bias)};
+}
+
+}  // namespace
+
+Eigen::Matrix2d RsuRegistry::covarianceAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const {
+  const Eigen::Vector2d sight = fix - rsu.position;
+  const double range = sight.norm();
+  if (!rsu.calibrated_variance || rsu.calibrated_error_by_range.empty() || !(range > 0.0)) return variance(rsu) * Eigen::Matrix2d::Identity();
+  const RsuInfo::ErrorAtRange e = errorAtRange(rsu.calibrated_error_by_range, range);
   const Eigen::Vector2d u = sight / range, v(-u.y(), u.x());
-  return along * u * u.transpose() + across * v * v.transpose();
+  return e.along_sd * e.along_sd * u * u.transpose() + e.across_sd * e.across_sd * v * v.transpose();
+}
+
+Eigen::Vector2d RsuRegistry::biasAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const {
+  const Eigen::Vector2d sight = fix - rsu.position;
+  const double range = sight.norm();
+  if (!rsu.calibrated_variance || rsu.calibrated_error_by_range.empty() || !(range > 0.0)) return Eigen::Vector2d::Zero();
+  const RsuInfo::ErrorAtRange e = errorAtRange(rsu.calibrated_error_by_range, range);
+  const Eigen::Vector2d u = sight / range, v(-u.y(), u.x());
+  return e.along_bias * u + e.across_bias * v;
 }
 
 double RsuRegistry::lidarVariance(const RsuInfo& rsu) const {

@@ -949,7 +949,7 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
               taken[i] += cam.apply(sent[i].fix, entry.position, std::atan2(v.y(), v.x())) - sent[i].fix;
           }
           const std::vector<rsu_client::RsuInfo::ErrorAtRange> by_range =
-              config.rsu_fix_error_by_range ? rsu_client::fixErrorByRange(entry.position, at, taken, kFixErrorBand, kFewestFixes)
+              config.rsu_fix_error_by_range ? rsu_client::fixErrorByRange(entry.position, at, taken, kFixErrorBand, kFewestFixes, config.rsu_fix_error_mean)
                                             : std::vector<rsu_client::RsuInfo::ErrorAtRange>{};
           if (const auto v = meanSquareFixVariance(taken)) {
             measured_variance[drive.site][r.id] = *v;

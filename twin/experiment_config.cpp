@@ -96,7 +96,11 @@ ExperimentConfig parseExperimentConfig(const std::string& yaml_text, const std::
     } else if (key == "calibration_clock_offset_ms") c.calibration_clock_offset_ms = r.inRange(v, key, -1000.0, 1000.0);
     else if (key == "oracle_fix_limit") c.oracle_fix_limit = r.inRange(v, key, 0.0, 100.0);
     else if (key == "rsu_background") c.rsu_background_learned = r.choice(v, key, {"learned", "surveyed"}) == "learned";
-    else if (key == "rsu_fix_error") c.rsu_fix_error_by_range = r.choice(v, key, {"by_range", "flat"}) == "by_range";
+    else if (key == "rsu_fix_error") {
+      const std::string how = r.choice(v, key, {"by_range", "by_range_and_mean", "flat"});
+      c.rsu_fix_error_by_range = how != "flat";
+      c.rsu_fix_error_mean = how == "by_range_and_mean";
+    }
     else if (key == "ndt_quality_map") c.ndt_quality_by_place = r.choice(v, key, {"by_place", "site"}) == "by_place";
     else if (key == "map_match_bias_length") c.map_match_bias_length = r.inRange(v, key, 0.0, 10000.0);
     else if (key == "ndt_quality_passes") c.ndt_quality_passes = static_cast<int>(r.integer(v, key, 1, 10));

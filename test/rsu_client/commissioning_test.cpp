@@ -132,6 +132,21 @@ TEST(FixErrorModel, EachRangeBandGivesTheErrorAlongAndAcrossTheLineOfSight) {
     EXPECT_NEAR(row.across_sd, across_sd(row.range), 0.05 * across_sd(row.range)) << row.range;
   }
   EXPECT_NEAR(table[2].range, 25.0, 0.5);
+  for (const RsuInfo::ErrorAtRange& row : table) EXPECT_EQ(row.along_bias, 0.0);  // not asked for
+  // A mean error of 2 cm across and -0.5 cm along every fix's line of sight: each band gives it back
+  // within three standard errors of its mean, and its spread about it.
+  std::vector<Eigen::Vector2d> pulled = residuals;
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    const Eigen::Vector2d u = (fixes[i] - rsu).normalized();
+    pulled[i] += 0.02 * Eigen::Vector2d(-u.y(), u.x()) - 0.005 * u;
+  }
+  const std::vector<RsuInfo::ErrorAtRange> with_mean = fixErrorByRange(rsu, fixes, pulled, 10.0, 5, true);
+  ASSERT_EQ(with_mean.size(), 5u);
+  for (const RsuInfo::ErrorAtRange& row : with_mean) {
+    EXPECT_NEAR(row.along_bias, -0.005, 0.0015) << row.range;
+    EXPECT_NEAR(row.across_bias, 0.02, 3.0 * across_sd(row.range) / std::sqrt(700.0)) << row.range;
+    EXPECT_NEAR(row.across_sd, across_sd(row.range), 0.05 * across_sd(row.range)) << row.range;
+  }
   EXPECT_TRUE(fixErrorByRange(rsu, {fixes.begin(), fixes.begin() + 4}, {residuals.begin(), residuals.begin() + 4}, 10.0, 5).empty());
   EXPECT_TRUE(fixErrorByRange(rsu, fixes, {residuals.begin(), residuals.begin() + 10}, 10.0, 5).empty());
 }

@@ -49,13 +49,16 @@ TEST(RsuRegistry, CalibratedVarianceOverridesTheModelsFigureWhateverThePlacement
 TEST(RsuRegistry, ACalibrationByRangeSurvivesTheFileFormat) {
   const RsuRegistry r = RsuRegistry::parse(
       "rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-32C, calibrated_variance: 0.0001,\n"
-      "     calibrated_error_by_range: [[5.5, 0.012, 0.02], [31.25, 0.011, 0.05]]}\n", "rsu.yaml");
+      "     calibrated_error_by_range: [[5.5, 0.012, 0.02], [31.25, 0.011, 0.05, 0.002, -0.013]]}\n", "rsu.yaml");
   const RsuRegistry again = RsuRegistry::parse(r.toYaml(), "again");
   const auto& table = again.find("a")->calibrated_error_by_range;
   ASSERT_EQ(table.size(), 2u);
   EXPECT_EQ(table[1].range, 31.25);
   EXPECT_EQ(table[1].along_sd, 0.011);
   EXPECT_EQ(table[1].across_sd, 0.05);
+  EXPECT_EQ(table[0].across_bias, 0.0);  // a row of three: no mean
+  EXPECT_EQ(table[1].along_bias, 0.002);
+  EXPECT_EQ(table[1].across_bias, -0.013);
   // 40 m along the diagonal, beyond the last row: 0.05^2 across the line of sight, 0.011^2 along it.
   const Eigen::Matrix2d c = again.covarianceAt(*again.find("a"), Eigen::Vector2d(40.0, 40.0) / std::sqrt(2.0));
   EXPECT_NEAR(c(0, 0), (0.011 * 0.011 + 0.05 * 0.05) / 2.0, 1e-12);
@@ -92,6 +95,8 @@ TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {
               "rsus[0].calibrated_error_by_range[1]: the ranges must increase");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: [[5, 0.01]]}\n",
               "rsus[0].calibrated_error_by_range[0]");
+  expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: [[5, 0.01, 0.01, .inf, 0]]}\n",
+              "rsus[0].calibrated_error_by_range[0]: each mean error must be within 10 m of 0");
   expectError("rsus:\n  - {id: a, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.01, calibrated_error_by_range: []}\n",
               "rsus[0].calibrated_error_by_range: expected a list");
   expectError("rsu:\n  - {}\n", "rsu: unknown key");

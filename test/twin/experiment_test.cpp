@@ -100,7 +100,9 @@ TEST(ExperimentConfig, BadKeysAndValuesNameTheKeyAndLine) {
   EXPECT_DOUBLE_EQ(parseExperimentConfig("oracle_fix_limit: 0.02\n", "exp.yaml").oracle_fix_limit, 0.02);
   EXPECT_FALSE(parseExperimentConfig("rsu_background: surveyed\n", "exp.yaml").rsu_background_learned);
   EXPECT_TRUE(parseExperimentConfig("rsu_fix_error: by_range\n", "exp.yaml").rsu_fix_error_by_range);
-  EXPECT_NE(errorOf("rsu_fix_error: linear\n").find("exp.yaml:1: rsu_fix_error: expected one of by_range, flat"), std::string::npos)
+  EXPECT_FALSE(parseExperimentConfig("rsu_fix_error: by_range\n", "exp.yaml").rsu_fix_error_mean);
+  EXPECT_TRUE(parseExperimentConfig("rsu_fix_error: by_range_and_mean\n", "exp.yaml").rsu_fix_error_mean);
+  EXPECT_NE(errorOf("rsu_fix_error: linear\n").find("exp.yaml:1: rsu_fix_error: expected one of by_range, by_range_and_mean, flat"), std::string::npos)
       << errorOf("rsu_fix_error: linear\n");
   EXPECT_NE(errorOf("rsu_background: empty\n").find("exp.yaml:1: rsu_background: expected one of learned, surveyed"), std::string::npos)
       << errorOf("rsu_background: empty\n");
@@ -137,6 +139,7 @@ TEST(ExperimentConfig, ShippedNdtAtItsNoiseConfigurationLoadsWithItsFuseFileFoun
   EXPECT_TRUE(c.twist_covariance_estimated);
   EXPECT_EQ(c.ndt_quality_passes, 2) << "NDT measured again under the filter that takes its map";
   EXPECT_TRUE(c.rsu_fix_error_by_range) << "the fixes at their error by range, as the noise calibration drive measures it";
+  EXPECT_TRUE(c.rsu_fix_error_mean) << "and its mean taken off";
   EXPECT_EQ(c.ndt_covariance, NdtCovarianceSource::kMultiNdtScore) << "the experiment's own, which hands each replay its quality map";
   const pipeline::Config fuse = pipeline::loadConfig(c.fuse_config);
   EXPECT_EQ(fuse.ndt.quality_floor, "noise");

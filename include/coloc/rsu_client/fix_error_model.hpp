@@ -11,13 +11,15 @@
 
 namespace coloc::rsu_client {
 
-/// From the fixes (map frame) of an RSU at `rsu_position` and their residuals against where the
-/// reference vehicle was, in the same order: per band of `band` metres of range, the root mean square
-/// of the residuals along and across each fix's line of sight, tails included (what the filter is
-/// given must cover what it gets), at the band's mean range. A band with fewer than `fewest` usable
-/// fixes (finite, off the RSU's own position) gives no row: the rows about it bridge it. Empty when no
-/// band has enough, or when the sizes differ.
+/// From the fixes (map frame) of an RSU at `rsu_position` and their residuals (fix minus where the
+/// reference vehicle was), in the same order: per band of `band` metres of range, the residuals along
+/// and across each fix's line of sight at the band's mean range. With `with_mean`, their mean (which
+/// the vehicle then takes off) and their standard deviation about it; without, the root mean square.
+/// Tails included either way: what the filter is given must cover what it gets. A band with fewer than
+/// `fewest` usable fixes (finite, off the RSU's own position) gives no row: the rows about it bridge
+/// it. Empty when no band has enough, or when the sizes differ.
 std::vector<RsuInfo::ErrorAtRange> fixErrorByRange(const Eigen::Vector2d& rsu_position, const std::vector<Eigen::Vector2d>& fixes,
-                                                   const std::vector<Eigen::Vector2d>& residuals, double band, std::size_t fewest);
+                                                   const std::vector<Eigen::Vector2d>& residuals, double band, std::size_t fewest,
+                                                   bool with_mean = false);
 
 }  // namespace coloc::rsu_client

@@ -121,6 +121,8 @@ struct ExperimentConfig {
   /// noise calibration drive (the registry's calibrated_variance and calibrated_bearing_sd), or `flat`,
   /// one mean square for every range (the default: by_range is not yet measured over ten trials).
   bool rsu_fix_error_by_range = false;
+  /// `by_range_and_mean`: by range, and each band's mean error too, which the vehicle takes off its fixes.
+  bool rsu_fix_error_mean = false;
 };
 
 /// The quick mode's defaults (`coloc experiment --quick`), a first look at the paper's results:
