@@ -750,11 +750,14 @@ struct Pipeline::Impl {
       }
       rsu_client::FixVerdict v = checker->check(fix->fix, arrival);
       if (!v.accepted()) return reject(v.detail);
-      // The CAM's rounding of this vehicle's size, taken back where the heading is known.
-      if (cam_size.enabled() && localizer.initialized())
+      // The CAM's rounding of this vehicle's size, and the mean error a calibration of the RSU by
+      // range measured in the vehicle's frame, taken back where the heading is known.
+      if (localizer.initialized())
         if (const rsu_client::RsuInfo* rsu = checker->registry().find(fix->fix.rsu_id)) {
           const double heading = rollPitchYaw(localizer.estimate()->pose.orientation)[2];
-          v.measurement.pose.position.head<2>() = cam_size.apply(v.measurement.pose.position.head<2>(), rsu->position, heading);
+          if (cam_size.enabled())
+            v.measurement.pose.position.head<2>() = cam_size.apply(v.measurement.pose.position.head<2>(), rsu->position, heading);
+          v.measurement.pose.position.head<2>() -= checker->registry().meanErrorAt(*rsu, v.measurement.pose.position.head<2>(), heading);
         }
       const fusion::SourceId source = fix_sources.at(fix->fix.rsu_id);
       fix_agreement.addFix(v.measurement.stamp, v.measurement.pose.position.head<2>(), 0.5 * v.measurement.covariance.topLeftCorner<2, 2>().trace());

@@ -206,11 +206,8 @@ FixVerdict FixChecker::checkKnown(const RsuFix& fix, Stamp now, const RsuInfo& k
   seen.push_back(fix.stamp);
   ++c.passed_checks;
   const Eigen::Matrix2d calibrated = registry_.covarianceAt(*rsu, Eigen::Vector2d(fix.x, fix.y));
-  // The mean error a calibration by range measured at this range, along and across the line of
-  // sight, taken off.
-  const Eigen::Vector2d bias = registry_.biasAt(*rsu, Eigen::Vector2d(fix.x, fix.y));
   v.measurement.stamp = fix.stamp;
-  v.measurement.pose.position = {fix.x - bias.x(), fix.y - bias.y(), 0.0};
+  v.measurement.pose.position = {fix.x, fix.y, 0.0};
   v.measurement.covariance = Matrix6d::Zero();
   v.measurement.covariance.diagonal() << 0.0, 0.0, kInfinity, kInfinity, kInfinity, kInfinity;
   v.measurement.covariance.topLeftCorner<2, 2>() = calibrated;

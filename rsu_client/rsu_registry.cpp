@@ -72,12 +72,12 @@ RsuInfo readRsu(const YamlReader& r, const YAML::Node& node, std::size_t index) 
       rsu.calibrated_variance = r.positive(entry.second, full);
     } else if (key == "calibrated_error_by_range") {
       if (!entry.second.IsSequence() || entry.second.size() == 0)
-        r.fail(entry.second, full, "expected a list of [range m, sd along m, sd across m(, mean along m, mean across m)], by increasing range");
+        r.fail(entry.second, full, "expected a list of [range m, sd along m, sd across m(, mean forward m, mean left m)], by increasing range");
       for (std::size_t i = 0; i < entry.second.size(); ++i) {
         const std::string row = full + "[" + std::to_string(i) + "]";
         const bool with_mean = entry.second[i].IsSequence() && entry.second[i].size() == 5;
         const auto v = r.numbers(entry.second[i], row, with_mean ? 5 : 3,
-                                 "[range m, sd along the line of sight m, sd across it m] or with the mean error along and across it after them");
+                                 "[range m, sd along the line of sight m, sd across it m] or with the mean error forward and left of the vehicle after them");
         if (!(v[0] >= 0.0 && v[0] <= 1000.0)) r.fail(entry.second[i], row, "the range must be within 0-1000 m");
         if (!(v[1] > 0.0 && v[1] <= 10.0 && v[2] > 0.0 && v[2] <= 10.0)) r.fail(entry.second[i], row, "each standard deviation must be within (0, 10] m");
         if (with_mean && !(std::abs(v[3]) <= 10.0 && std::abs(v[4]) <= 10.0)) r.fail(entry.second[i], row, "each mean error must be within 10 m of 0");
@@ -185,10 +185,10 @@ std::string RsuRegistry::toYaml() const {
         << "    identity: \"" << r.identity << "\"\n";
     if (r.calibrated_variance) out << "    calibrated_variance: " << number(*r.calibrated_variance) << "\n";
     if (!r.calibrated_error_by_range.empty()) {
-      out << "    calibrated_error_by_range:  # [range m, sd along the line of sight m, sd across it m(, mean along m, mean across m)]\n";
+      out << "    calibrated_error_by_range:  # [range m, sd along the line of sight m, sd across it m(, mean forward m, mean left m)]\n";
       for (const RsuInfo::ErrorAtRange& e : r.calibrated_error_by_range) {
         out << "      - [" << number(e.range) << ", " << number(e.along_sd) << ", " << number(e.across_sd);
-        if (e.along_bias != 0.0 || e.across_bias != 0.0) out << ", " << number(e.along_bias) << ", " << number(e.across_bias);
+        if (e.forward_mean != 0.0 || e.left_mean != 0.0) out << ", " << number(e.forward_mean) << ", " << number(e.left_mean);
         out << "]\n";
       }
     }
@@ -219,7 +219,7 @@ RsuInfo::ErrorAtRange errorAtRange(const std::vector<RsuInfo::ErrorAtRange>& tab
   const double w = hi.range > lo.range ? std::clamp((range - lo.range) / (hi.range - lo.range), 0.0, 1.0) : 0.0;
   auto mix = [w](double a, double b) { return (1.0 - w) * a + w * b; };
   return {range, std::sqrt(mix(lo.along_sd * lo.along_sd, hi.along_sd * hi.along_sd)), std::sqrt(mix(lo.across_sd * lo.across_sd, hi.across_sd * hi.across_sd)),
-          mix(lo.along_bias, hi.along_bias), mix(lo.across_bias, hi.across_bias)};
+          mix(lo.forward_mean, hi.forward_mean), mix(lo.left_mean, hi.left_mean)};
 }
 
 }  // namespace
@@ -233,13 +233,13 @@ Eigen::Matrix2d RsuRegistry::covarianceAt(const RsuInfo& rsu, const Eigen::Vecto
   return e.along_sd * e.along_sd * u * u.transpose() + e.across_sd * e.across_sd * v * v.transpose();
 }
 
-Eigen::Vector2d RsuRegistry::biasAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const {
-  const Eigen::Vector2d sight = fix - rsu.position;
-  const double range = sight.norm();
-  if (!rsu.calibrated_variance || rsu.calibrated_error_by_range.empty() || !(range > 0.0)) return Eigen::Vector2d::Zero();
+Eigen::Vector2d RsuRegistry::meanErrorAt(const RsuInfo& rsu, const Eigen::Vector2d& fix, double yaw) const {
+  const double range = (fix - rsu.position).norm();
+  if (!rsu.calibrated_variance || rsu.calibrated_error_by_range.empty() || !std::isfinite(range) || !std::isfinite(yaw))
+    return Eigen::Vector2d::Zero();
   const RsuInfo::ErrorAtRange e = errorAtRange(rsu.calibrated_error_by_range, range);
-  const Eigen::Vector2d u = sight / range, v(-u.y(), u.x());
-  return e.along_bias * u + e.across_bias * v;
+  const Eigen::Vector2d forward(std::cos(yaw), std::sin(yaw)), left(-forward.y(), forward.x());
+  return e.forward_mean * forward + e.left_mean * left;
 }
 
 double RsuRegistry::lidarVariance(const RsuInfo& rsu) const {

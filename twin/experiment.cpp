@@ -942,15 +942,19 @@ ExperimentResults runExperiment(const ExperimentConfig& config, const std::strin
           const pipeline::CamSizeCorrection cam{fuse.rsu.vehicle_length, fuse.rsu.vehicle_width, fuse.rsu.cam_size_step, fuse.rsu.cam_length,
                                                 fuse.rsu.cam_width};
           std::vector<Eigen::Vector2d> at, taken = residuals;
+          std::vector<double> headings;
           for (std::size_t i = 0; i < sent.size(); ++i) {
             at.push_back(sent[i].fix);
             const Eigen::Vector2d& v = sent[i].velocity;
-            if (cam.enabled() && i < taken.size() && v.norm() > 0.1)
-              taken[i] += cam.apply(sent[i].fix, entry.position, std::atan2(v.y(), v.x())) - sent[i].fix;
+            const double heading = v.norm() > 0.1 ? std::atan2(v.y(), v.x()) : std::nan("");  // none standing
+            headings.push_back(heading);
+            if (cam.enabled() && i < taken.size() && std::isfinite(heading)) taken[i] += cam.apply(sent[i].fix, entry.position, heading) - sent[i].fix;
           }
           const std::vector<rsu_client::RsuInfo::ErrorAtRange> by_range =
-              config.rsu_fix_error_by_range ? rsu_client::fixErrorByRange(entry.position, at, taken, kFixErrorBand, kFewestFixes, config.rsu_fix_error_mean)
-                                            : std::vector<rsu_client::RsuInfo::ErrorAtRange>{};
+              config.rsu_fix_error_by_range
+                  ? rsu_client::fixErrorByRange(entry.position, at, taken, kFixErrorBand, kFewestFixes,
+                                                config.rsu_fix_error_mean ? headings : std::vector<double>{})
+                  : std::vector<rsu_client::RsuInfo::ErrorAtRange>{};
           if (const auto v = meanSquareFixVariance(taken)) {
             measured_variance[drive.site][r.id] = *v;
             results.estimated_variance[reportKey(scenario, r)] = *v;

@@ -132,21 +132,30 @@ TEST(FixErrorModel, EachRangeBandGivesTheErrorAlongAndAcrossTheLineOfSight) {
     EXPECT_NEAR(row.across_sd, across_sd(row.range), 0.05 * across_sd(row.range)) << row.range;
   }
   EXPECT_NEAR(table[2].range, 25.0, 0.5);
-  for (const RsuInfo::ErrorAtRange& row : table) EXPECT_EQ(row.along_bias, 0.0);  // not asked for
-  // A mean error of 2 cm across and -0.5 cm along every fix's line of sight: each band gives it back
-  // within three standard errors of its mean, and its spread about it.
+  for (const RsuInfo::ErrorAtRange& row : table) EXPECT_EQ(row.left_mean, 0.0);  // not asked for
+  // A mean error of 2 cm to the right of the vehicle and 0.5 cm behind it, the vehicle coming
+  // (heading west, towards the RSU's x) or going (east) at random: across the line of sight the
+  // pull has either sign, in the vehicle's frame one. Each band gives it back within three standard
+  // errors of its mean, and its spread about it.
+  std::uniform_int_distribution<int> way(0, 1);
   std::vector<Eigen::Vector2d> pulled = residuals;
+  std::vector<double> headings;
   for (std::size_t i = 0; i < fixes.size(); ++i) {
-    const Eigen::Vector2d u = (fixes[i] - rsu).normalized();
-    pulled[i] += 0.02 * Eigen::Vector2d(-u.y(), u.x()) - 0.005 * u;
+    const double yaw = way(rng) ? 0.0 : M_PI;
+    const Eigen::Vector2d forward(std::cos(yaw), std::sin(yaw)), left(-forward.y(), forward.x());
+    pulled[i] += -0.02 * left - 0.005 * forward;
+    headings.push_back(yaw);
   }
-  const std::vector<RsuInfo::ErrorAtRange> with_mean = fixErrorByRange(rsu, fixes, pulled, 10.0, 5, true);
+  headings[9] = std::nan("");  // a fix without a heading is left out of the means and spreads
+  const std::vector<RsuInfo::ErrorAtRange> with_mean = fixErrorByRange(rsu, fixes, pulled, 10.0, 5, headings);
   ASSERT_EQ(with_mean.size(), 5u);
   for (const RsuInfo::ErrorAtRange& row : with_mean) {
-    EXPECT_NEAR(row.along_bias, -0.005, 0.0015) << row.range;
-    EXPECT_NEAR(row.across_bias, 0.02, 3.0 * across_sd(row.range) / std::sqrt(700.0)) << row.range;
+    EXPECT_NEAR(row.forward_mean, -0.005, 3.0 * 0.05 / std::sqrt(700.0)) << row.range;
+    EXPECT_NEAR(row.left_mean, -0.02, 3.0 * 0.05 / std::sqrt(700.0)) << row.range;
+    EXPECT_NEAR(row.along_sd, 0.01, 0.0006) << row.range;
     EXPECT_NEAR(row.across_sd, across_sd(row.range), 0.05 * across_sd(row.range)) << row.range;
   }
+  EXPECT_TRUE(fixErrorByRange(rsu, fixes, pulled, 10.0, 5, {headings.begin(), headings.begin() + 10}).empty());  // sizes differ
   EXPECT_TRUE(fixErrorByRange(rsu, {fixes.begin(), fixes.begin() + 4}, {residuals.begin(), residuals.begin() + 4}, 10.0, 5).empty());
   EXPECT_TRUE(fixErrorByRange(rsu, fixes, {residuals.begin(), residuals.begin() + 10}, 10.0, 5).empty());
 }

@@ -289,33 +289,6 @@ TEST(FixChecker, ACalibrationByRangeGivesEachFixItsRangesErrorAlongAndAcrossItsL
   EXPECT_NEAR(v.measurement.covariance(0, 1), 0.0, 1e-12);
 }
 
-// A calibration by range with the mean error each band measured: the vehicle takes it off each fix,
-// along and across its line of sight at its range (a far car's fit pulled towards the RSU).
-TEST(FixChecker, TheMeanErrorACalibrationByRangeMeasuredIsTakenOffEachFix) {
-  FixChecker c = acceptingUnaddressed(
-      "rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, coverage_radius: 50, calibrated_variance: 0.0004,\n"
-      "     calibrated_error_by_range: [[10, 0.01, 0.01, 0.0, 0.0], [40, 0.01, 0.02, 0.004, -0.03]]}\n");
-  RsuFix east = sentFix(kNow - 1000, 140);  // 40 m east: along is +x, across is +y
-  FixVerdict v = c.check(east, kNow);
-  ASSERT_TRUE(v.accepted()) << v.detail;
-  EXPECT_NEAR(v.measurement.pose.position.x(), 140.0 - 0.004, 1e-12);
-  EXPECT_NEAR(v.measurement.pose.position.y(), 0.0 + 0.03, 1e-12);
-  RsuFix north = sentFix(kNow - 900, 100);
-  north.y = 25.0;  // 25 m north, halfway: along is +y, across is -x
-  v = c.check(north, kNow);
-  ASSERT_TRUE(v.accepted()) << v.detail;
-  EXPECT_NEAR(v.measurement.pose.position.y(), 25.0 - 0.002, 1e-12);
-  EXPECT_NEAR(v.measurement.pose.position.x(), 100.0 - 0.015, 1e-12);
-  // Without a mean in the rows, nothing is taken off.
-  FixChecker plain = acceptingUnaddressed(
-      "rsus:\n  - {id: rsu_a, position: [100, 0], lidar_model: VLP-16, coverage_radius: 50, calibrated_variance: 0.0004,\n"
-      "     calibrated_error_by_range: [[10, 0.01, 0.01], [40, 0.01, 0.02]]}\n");
-  v = plain.check(sentFix(kNow - 800, 140), kNow);
-  ASSERT_TRUE(v.accepted()) << v.detail;
-  EXPECT_EQ(v.measurement.pose.position.x(), 140.0);
-  EXPECT_EQ(v.measurement.pose.position.y(), 0.0);
-}
-
 TEST(FixChecker, DelayedAndLostFixesAreHandledAsTheFilterPromises) {
   // Fixes at 10 Hz from a vehicle standing at (105, 1): one arrives 0.4 s late, one is lost. The
   // filter applies the late one at its capture time: the result equals on-time delivery.

@@ -56,9 +56,9 @@ TEST(RsuRegistry, ACalibrationByRangeSurvivesTheFileFormat) {
   EXPECT_EQ(table[1].range, 31.25);
   EXPECT_EQ(table[1].along_sd, 0.011);
   EXPECT_EQ(table[1].across_sd, 0.05);
-  EXPECT_EQ(table[0].across_bias, 0.0);  // a row of three: no mean
-  EXPECT_EQ(table[1].along_bias, 0.002);
-  EXPECT_EQ(table[1].across_bias, -0.013);
+  EXPECT_EQ(table[0].left_mean, 0.0);  // a row of three: no mean
+  EXPECT_EQ(table[1].forward_mean, 0.002);
+  EXPECT_EQ(table[1].left_mean, -0.013);
   // 40 m along the diagonal, beyond the last row: 0.05^2 across the line of sight, 0.011^2 along it.
   const Eigen::Matrix2d c = again.covarianceAt(*again.find("a"), Eigen::Vector2d(40.0, 40.0) / std::sqrt(2.0));
   EXPECT_NEAR(c(0, 0), (0.011 * 0.011 + 0.05 * 0.05) / 2.0, 1e-12);
@@ -69,6 +69,29 @@ TEST(RsuRegistry, ACalibrationByRangeSurvivesTheFileFormat) {
   EXPECT_EQ(f(0, 0), 0.0002);
   EXPECT_EQ(f(1, 1), 0.0002);
   EXPECT_EQ(f(0, 1), 0.0);
+}
+
+// The mean error of a calibration by range is in the vehicle's frame: a fix 40 m east of the RSU of a
+// vehicle heading north is off by the row's forward mean northwards and its left mean westwards,
+// heading south the other way round; interpolated in range like the spreads, and nothing without a
+// table or without a heading.
+TEST(RsuRegistry, TheMeanErrorByRangeIsInTheVehiclesFrame) {
+  const RsuRegistry r = RsuRegistry::parse(
+      "rsus:\n  - {id: a, position: [100, 0], lidar_model: VLP-16, coverage_radius: 50, calibrated_variance: 0.0004,\n"
+      "     calibrated_error_by_range: [[10, 0.01, 0.01, 0.0, 0.0], [40, 0.01, 0.02, 0.004, -0.03]]}\n", "rsu.yaml");
+  const RsuInfo& a = *r.find("a");
+  Eigen::Vector2d m = r.meanErrorAt(a, Eigen::Vector2d(140, 0), M_PI / 2.0);  // heading north: left is west
+  EXPECT_NEAR(m.x(), 0.03, 1e-12);
+  EXPECT_NEAR(m.y(), 0.004, 1e-12);
+  m = r.meanErrorAt(a, Eigen::Vector2d(140, 0), -M_PI / 2.0);  // heading south: left is east
+  EXPECT_NEAR(m.x(), -0.03, 1e-12);
+  EXPECT_NEAR(m.y(), -0.004, 1e-12);
+  m = r.meanErrorAt(a, Eigen::Vector2d(100, 25), 0.0);  // 25 m, halfway; heading east: left is north
+  EXPECT_NEAR(m.x(), 0.002, 1e-12);
+  EXPECT_NEAR(m.y(), -0.015, 1e-12);
+  EXPECT_EQ(r.meanErrorAt(a, Eigen::Vector2d(140, 0), std::nan("")), Eigen::Vector2d::Zero());
+  const RsuRegistry flat = RsuRegistry::parse("rsus:\n  - {id: b, position: [0, 0], lidar_model: VLP-16, calibrated_variance: 0.0002}\n", "x");
+  EXPECT_EQ(flat.meanErrorAt(*flat.find("b"), Eigen::Vector2d(20, 0), 0.0), Eigen::Vector2d::Zero());
 }
 
 TEST(RsuRegistry, ConfigErrorsNameTheKeyAndLine) {

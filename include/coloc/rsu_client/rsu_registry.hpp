@@ -58,15 +58,17 @@ struct RsuInfo {
   std::optional<double> calibrated_variance;
   /// With calibrated_variance: the fixes' error by their range from the RSU (calibrated_error_by_range
   /// in the file), each row a range (m), the standard deviations (m) along and across the line of
-  /// sight measured there and, optionally, the mean error (m) along and across it, which the vehicle
-  /// takes off each fix; a fix between two rows takes the figures interpolated in range, one beyond
-  /// the first or last row that row's. A LiDAR measures range to a centimetre at any distance, but
+  /// sight measured there and, optionally, the mean error (m) forward and to the left of the vehicle,
+  /// which the vehicle takes off each fix by its heading; a fix between two rows takes the figures
+  /// interpolated in range, one beyond the first or last row that row's. The mean is in the vehicle's
+  /// frame because a far car's fit is pulled towards the side it shows the RSU: across the line of
+  /// sight that pull has one sign as the car comes and the other as it goes. A LiDAR measures range to a centimetre at any distance, but
   /// its beams thin out and its fit sees other faces as the car passes: what it gets wrong depends on
   /// the range and the direction, and one figure for all overstates the near fixes and understates the
   /// far ones (docs/rsu-protocol.md).
   struct ErrorAtRange {
     double range = 0.0, along_sd = 0.0, across_sd = 0.0;
-    double along_bias = 0.0, across_bias = 0.0;  ///< the mean error, fix minus truth
+    double forward_mean = 0.0, left_mean = 0.0;  ///< the mean error (fix minus truth) in the vehicle's frame
   };
   std::vector<ErrorAtRange> calibrated_error_by_range;
   std::optional<RsuCalibrationEntry> calibration;
@@ -96,9 +98,9 @@ class RsuRegistry {
   /// or, where the calibration has it by range, its error at this fix's range along and across the
   /// line of sight from the RSU.
   Eigen::Matrix2d covarianceAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const;
-  /// The mean error (fix minus truth, map frame) the calibration by range measured at `fix`'s range,
-  /// along and across its line of sight; zero without one.
-  Eigen::Vector2d biasAt(const RsuInfo& rsu, const Eigen::Vector2d& fix) const;
+  /// The mean error (fix minus truth, map frame) the calibration by range measured at `fix`'s range
+  /// for a vehicle heading `yaw` (rad, map frame); zero without one.
+  Eigen::Vector2d meanErrorAt(const RsuInfo& rsu, const Eigen::Vector2d& fix, double yaw) const;
   /// The model's figure alone, placed as the registry says: the least an RSU of this LiDAR may send.
   double lidarVariance(const RsuInfo& rsu) const;
 
