@@ -11,6 +11,7 @@
 #include "coloc/pipeline/pipeline.hpp"
 #include "measurements.hpp"
 #include "one_rsu.hpp"
+#include "pass_by_rsu.hpp"
 
 namespace coloc::pipeline {
 namespace {
@@ -75,30 +76,9 @@ TEST(CamSizeCorrection, AV2xStackThatRoundsDownIsTakenAtWhatItSends) {
 // its CAM's 4.9 x 1.8 (2 cm towards the RSU on every fix, 1 cm along). Given its own size, the vehicle's
 // estimate sits on its track; without it, 2 cm to the RSU's side.
 double meanLeftOfTrack(const Config& config) {
-  using coloc::testing::kStart;
-  using coloc::testing::kTick;
-  constexpr std::uint32_t kEgo = 1001;
   const Eigen::Vector2d rsu(0.0, 8.0);
-  Pipeline pipe(config, PipelineOptions{std::nullopt, coloc::testing::oneRsu(rsu, 60.0), false, {}, nullptr, nullptr});
-  const fusion::SourceId odom = pipe.addTwistSource("odom");
-  std::vector<fusion::Estimate> estimates;
-  pipe.onEstimate([&](const fusion::Estimate& e) { estimates.push_back(e); });
-  const auto truth = [&](Stamp t) { return Eigen::Vector2d(-40.0 + 10.0 * toSeconds(t - kStart), 0.0); };
-  pipe.pushInitialPose(coloc::testing::planarPose(kStart, -40.0, 0.0, 0.0, 0.01, 0.001), kStart);
-  for (Stamp t = kStart; t <= kStart + 8'000'000'000; t += kTick) {
-    pipe.pushTwist(odom, coloc::testing::twist(t, 10.0, 0.0), t + 2'000'000);
-    const int k = static_cast<int>((t - kStart) / kTick);
-    if (k % 5 == 2) {
-      const Eigen::Vector2d p = boxCentre(truth(t), 0.0, rsu) + 0.005 * Eigen::Vector2d(std::sin(k), std::cos(3 * k));
-      pipe.pushFix({t, "rsu_a", p.x(), p.y(), std::nullopt, std::nullopt, kEgo}, t + 60'000'000);
-    }
-    pipe.runUntil(t);
-  }
-  double sum = 0.0;
-  int n = 0;
-  for (const fusion::Estimate& e : estimates)
-    if (e.stamp >= kStart + 2'000'000'000 && e.stamp <= kStart + 6'000'000'000) sum += e.pose.position.y(), ++n;
-  return n ? sum / n : std::nan("");
+  return coloc::testing::meanLeftOfTrackPassingRsu(config, coloc::testing::oneRsu(rsu, 60.0),
+                                                   [&](const Eigen::Vector2d& truth) -> Eigen::Vector2d { return boxCentre(truth, 0.0, rsu); });
 }
 
 TEST(CamSizeCorrection, AVehicleGivenItsOwnSizeIsNotPulledTowardsTheRsuByItsCamsRounding) {
