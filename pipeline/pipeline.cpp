@@ -753,7 +753,8 @@ struct Pipeline::Impl {
       // The CAM's rounding of this vehicle's size, and the mean error a calibration of the RSU by
       // range measured in the vehicle's frame, taken back where the heading is known.
       if (localizer.initialized())
-        if (const rsu_client::RsuInfo* rsu = checker->registry().find(fix->fix.rsu_id)) {
+        if (const rsu_client::RsuInfo* rsu = checker->registry().find(fix->fix.rsu_id);
+            rsu && (cam_size.enabled() || !rsu->calibrated_error_by_range.empty())) {
           const double heading = rollPitchYaw(localizer.estimate()->pose.orientation)[2];
           if (cam_size.enabled())
             v.measurement.pose.position.head<2>() = cam_size.apply(v.measurement.pose.position.head<2>(), rsu->position, heading);
